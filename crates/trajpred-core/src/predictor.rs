@@ -1,0 +1,204 @@
+//! The [`Predictor`] trait every method implements, and the [`Forecast`] it returns.
+
+use crate::error::{Error, Result};
+use crate::trajectory::{MAX_AXES, Point, Trajectory};
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+/// Predicted points for steps `1..=horizon` after the forecast origin, and, where the method
+/// has them, the covariance of each prediction.
+///
+/// ```
+/// use trajpred_core::Forecast;
+/// let f = Forecast::new(2, vec![vec![1.0, 2.0], vec![3.0, 4.0]])?;
+/// assert_eq!(f.horizon(), 2);
+/// assert_eq!(f.step(2), &[3.0, 4.0]);
+/// assert!(f.covariance(1).is_none());
+/// # Ok::<(), trajpred_core::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Forecast {
+    dim: usize,
+    /// `horizon * dim` values, step by step.
+    means: Vec<f64>,
+    covariances: Option<Vec<DMatrix<f64>>>,
+}
+
+impl Forecast {
+    /// A forecast of `dim`-axis points, one per step. Every point must have `dim` finite values.
+    pub fn new<P: AsRef<[f64]>>(dim: usize, steps: Vec<P>) -> Result<Self> {
+        if dim == 0 || dim > MAX_AXES {
+            return Err(Error::UnsupportedDimension { got: dim });
+        }
+        if steps.is_empty() {
+            return Err(Error::Empty { what: "forecast" });
+        }
+        let mut means = Vec::with_capacity(steps.len() * dim);
+        for (i, p) in steps.iter().enumerate() {
+            let p = p.as_ref();
+            if p.len() != dim {
+                return Err(Error::DimensionMismatch {
+                    what: "forecast step",
+                    expected: dim,
+                    got: p.len(),
+                });
+            }
+            if p.iter().any(|v| !v.is_finite()) {
+                return Err(Error::NonFinite {
+                    what: "forecast",
+                    index: i,
+                });
+            }
+            means.extend_from_slice(p);
+        }
+        Ok(Forecast {
+            dim,
+            means,
+            covariances: None,
+        })
+    }
+
+    /// Attaches one `dim x dim` covariance per step.
+    pub fn with_covariances(mut self, covariances: Vec<DMatrix<f64>>) -> Result<Self> {
+        if covariances.len() != self.horizon() {
+            return Err(Error::LengthMismatch {
+                what: "covariances vs forecast steps",
+                expected: self.horizon(),
+                got: covariances.len(),
+            });
+        }
+        for (i, c) in covariances.iter().enumerate() {
+            if c.nrows() != self.dim || c.ncols() != self.dim {
+                return Err(Error::DimensionMismatch {
+                    what: "forecast covariance",
+                    expected: self.dim,
+                    got: c.nrows().max(c.ncols()),
+                });
+            }
+            if c.iter().any(|v| !v.is_finite()) {
+                return Err(Error::NonFinite {
+                    what: "forecast covariance",
+                    index: i,
+                });
+            }
+        }
+        self.covariances = Some(covariances);
+        Ok(self)
+    }
+
+    /// Number of axes of each predicted point.
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    /// Number of predicted steps.
+    pub fn horizon(&self) -> usize {
+        self.means.len() / self.dim
+    }
+
+    /// The prediction `k` steps ahead (`1 <= k <= horizon`). Panics outside that range.
+    pub fn step(&self, k: usize) -> &[f64] {
+        assert!(
+            k >= 1 && k <= self.horizon(),
+            "step {k} outside 1..={}",
+            self.horizon()
+        );
+        &self.means[(k - 1) * self.dim..k * self.dim]
+    }
+
+    /// The predicted points, step 1 first.
+    pub fn points(&self) -> impl ExactSizeIterator<Item = Point> + '_ {
+        self.means.chunks_exact(self.dim).map(|c| {
+            Point::new(c).unwrap_or_else(|_| unreachable!("dim checked at construction"))
+        })
+    }
+
+    /// The covariance of the prediction `k` steps ahead, if the method provides one.
+    pub fn covariance(&self, k: usize) -> Option<&DMatrix<f64>> {
+        self.covariances.as_ref().and_then(|c| c.get(k.checked_sub(1)?))
+    }
+}
+
+/// A trajectory predictor: fitted once on training trajectories, then asked for `horizon`
+/// steps after the end of any history.
+///
+/// Contract, for every implementation:
+/// - **Causal**: `forecast` sees only `history`; the forecast made at an origin never depends
+///   on anything after it. (The evaluation harness passes `history = trajectory[..=origin]`.)
+/// - **Deterministic**: the same fitted predictor and history give the same forecast; any
+///   randomness is seeded by the predictor's parameters.
+/// - Steps are the history's sampling steps; methods that need a time step take it from the
+///   history's timestamps.
+/// - Errors, never panics, for bad input.
+///
+/// The trait is object safe, so a method chosen at run time is a `Box<dyn Predictor>`:
+///
+/// ```
+/// use trajpred_core::{Forecast, Predictor, Result, Trajectory};
+///
+/// /// Repeats the last point.
+/// struct Persistence;
+/// impl Predictor for Persistence {
+///     fn name(&self) -> &str { "persistence" }
+///     fn fit(&mut self, _train: &[Trajectory]) -> Result<()> { Ok(()) }
+///     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
+///         let last = history.last_point();
+///         Forecast::new(history.dim(), vec![last; horizon])
+///     }
+/// }
+///
+/// let mut p: Box<dyn Predictor> = Box::new(Persistence);
+/// let tr = Trajectory::uniform(0.0, 1.0, vec![vec![1.0, 2.0, 3.0]])?;
+/// p.fit(std::slice::from_ref(&tr))?;
+/// assert_eq!(p.forecast(&tr, 2)?.step(2), &[3.0]);
+/// # Ok::<(), trajpred_core::Error>(())
+/// ```
+pub trait Predictor: Send + Sync {
+    /// A short, stable name (used in tables and on the command line).
+    fn name(&self) -> &str;
+
+    /// Learns whatever the method learns from training trajectories (may be a no-op).
+    fn fit(&mut self, train: &[Trajectory]) -> Result<()>;
+
+    /// Predicts `horizon` steps after the last point of `history`.
+    fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast>;
+
+    /// The shortest history `forecast` accepts.
+    fn min_history(&self) -> usize {
+        1
+    }
+}
+
+impl<P: Predictor + ?Sized> Predictor for Box<P> {
+    fn name(&self) -> &str {
+        (**self).name()
+    }
+    fn fit(&mut self, train: &[Trajectory]) -> Result<()> {
+        (**self).fit(train)
+    }
+    fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
+        (**self).forecast(history, horizon)
+    }
+    fn min_history(&self) -> usize {
+        (**self).min_history()
+    }
+}
+
+/// Checks the arguments every `forecast` must check: `horizon >= 1` and a long enough
+/// history. Implementations call it first.
+pub fn check_forecast_args(history: &Trajectory, horizon: usize, min_history: usize) -> Result<()> {
+    if horizon == 0 {
+        return Err(Error::InvalidParameter {
+            name: "horizon",
+            reason: "must be at least 1".into(),
+        });
+    }
+    if history.len() < min_history {
+        return Err(Error::TooShort {
+            what: "history",
+            needed: min_history,
+            got: history.len(),
+        });
+    }
+    Ok(())
+}
