@@ -1,0 +1,367 @@
+//! The filtering loop shared by every filter: [`Filter`] (predict, update, step, batch,
+//! k-step forecast, control input), the result types [`Update`] and [`Step`], the covariance
+//! update forms [`CovarianceUpdate`], and the RTS smoother [`Smoother`].
+
+use crate::error::{KalmanError, Result};
+use crate::linalg::{check_dim, check_finite, check_state, cholesky, log_det, symmetrise};
+use crate::model::Observation;
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
+use trajpred_core::Gaussian;
+
+/// How the posterior covariance is computed from the prior `P`, the gain `K` and `H`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CovarianceUpdate {
+    /// Joseph form `(I - K H) P (I - K H)^T + K R K^T`, then symmetrised: stays symmetric
+    /// positive semi-definite under rounding and for any gain. The default.
+    #[default]
+    Joseph,
+    /// The plain form `(I - K H) P`, as printed in most papers; not symmetrised.
+    Plain,
+    /// The plain form followed by symmetrisation `(P + P^T) / 2`.
+    Symmetrised,
+}
+
+/// Everything an update step computed: the posterior and, for the caller's diagnostics
+/// (NIS, gating, likelihood-based model selection), the innovation `y = z - h(x)`, its
+/// covariance `S`, the gain `K` and the log-likelihood `ln N(y; 0, S)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Update<T: RealField, D: Dim, M: Dim>
+where
+    DefaultAllocator:
+        Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M> + Allocator<D, M>,
+{
+    /// The posterior `N(x(k|k), P(k|k))`.
+    pub posterior: Gaussian<T, D>,
+    /// The innovation `y = z - h(x(k|k-1))` (through the observation's residual function).
+    pub innovation: OVector<T, M>,
+    /// The innovation covariance `S`.
+    pub innovation_covariance: OMatrix<T, M, M>,
+    /// The gain `K`.
+    pub gain: OMatrix<T, D, M>,
+    /// `ln N(y; 0, S) = -(m ln 2 pi + ln det S + y^T S^-1 y) / 2`.
+    pub log_likelihood: T,
+}
+
+/// One filter step: the prior `N(x(k|k-1), P(k|k-1))` and, when there was an observation,
+/// its update.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Step<T: RealField, D: Dim, M: Dim>
+where
+    DefaultAllocator:
+        Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M> + Allocator<D, M>,
+{
+    /// The predicted state.
+    pub prior: Gaussian<T, D>,
+    /// The update, `None` for a missing observation.
+    pub update: Option<Update<T, D, M>>,
+}
+
+impl<T: RealField, D: Dim, M: Dim> Step<T, D, M>
+where
+    DefaultAllocator:
+        Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M> + Allocator<D, M>,
+{
+    /// The filtered state: the update's posterior, or the prior when the observation was
+    /// missing.
+    pub fn posterior(&self) -> &Gaussian<T, D> {
+        match &self.update {
+            Some(u) => &u.posterior,
+            None => &self.prior,
+        }
+    }
+
+    /// The log-likelihood of this step's observation (0 when it was missing).
+    pub fn log_likelihood(&self) -> T
+    where
+        T: Copy,
+    {
+        self.update
+            .as_ref()
+            .map_or_else(T::zero, |u| u.log_likelihood)
+    }
+}
+
+/// The interface of every Gaussian filter of the crate: the two steps as pure functions of
+/// an explicit Gaussian state (no hidden state, so one filter value can serve many particles
+/// or tracks), and, built on them once for all filters, the step with an optional
+/// observation, the batch over a sequence and the k-step forecast.
+///
+/// Inputs are validated (shapes, finite values, `P` symmetric positive semi-definite);
+/// failures are typed [`KalmanError`]s.
+pub trait Filter<T: RealField + Copy, D: Dim, M: Dim>
+where
+    DefaultAllocator: Allocator<D>
+        + Allocator<D, D>
+        + Allocator<M>
+        + Allocator<M, M>
+        + Allocator<D, M>
+        + Allocator<M, D>,
+{
+    /// The prediction `N(x(k|k-1), P(k|k-1))` from the previous estimate.
+    fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>>;
+
+    /// The update of `prior` by the observation `z`.
+    fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>>;
+
+    /// The prediction with a known control effect `B u` (already mapped to the state space)
+    /// added to the predicted mean: `x(k|k-1) = f(x) + B u`. The covariance is unchanged,
+    /// since the control input carries no noise.
+    fn predict_with_control(
+        &self,
+        state: &Gaussian<T, D>,
+        control_effect: &OVector<T, D>,
+    ) -> Result<Gaussian<T, D>> {
+        check_dim("control effect", state.mean.nrows(), control_effect.nrows())?;
+        check_finite(control_effect, "control effect")?;
+        let mut prior = self.predict(state)?;
+        prior.mean += control_effect;
+        Ok(prior)
+    }
+
+    /// Predict, then update when `z` is `Some` (a missing observation is `None`).
+    fn step(&self, state: &Gaussian<T, D>, z: Option<&OVector<T, M>>) -> Result<Step<T, D, M>> {
+        let prior = self.predict(state)?;
+        let update = match z {
+            Some(z) => Some(self.update(&prior, z)?),
+            None => None,
+        };
+        Ok(Step { prior, update })
+    }
+
+    /// Runs [`Filter::step`] over a sequence of observations starting from `initial` (the
+    /// estimate before the first observation's time). Returns one [`Step`] per observation.
+    fn filter(
+        &self,
+        initial: &Gaussian<T, D>,
+        observations: &[Option<OVector<T, M>>],
+    ) -> Result<Vec<Step<T, D, M>>> {
+        let mut out: Vec<Step<T, D, M>> = Vec::with_capacity(observations.len());
+        for z in observations {
+            let step = match out.last() {
+                Some(prev) => self.step(prev.posterior(), z.as_ref())?,
+                None => self.step(initial, z.as_ref())?,
+            };
+            out.push(step);
+        }
+        Ok(out)
+    }
+
+    /// The total log-likelihood `sum_k ln N(y_k; 0, S_k)` of a sequence (missing
+    /// observations contribute nothing).
+    fn log_likelihood(
+        &self,
+        initial: &Gaussian<T, D>,
+        observations: &[Option<OVector<T, M>>],
+    ) -> Result<T> {
+        Ok(self
+            .filter(initial, observations)?
+            .iter()
+            .fold(T::zero(), |acc, s| acc + s.log_likelihood()))
+    }
+
+    /// The forecast `N(x(k+j|k), P(k+j|k))` for `j = 1..=steps`: the prediction applied
+    /// `steps` times without observations.
+    fn forecast(&self, state: &Gaussian<T, D>, steps: usize) -> Result<Vec<Gaussian<T, D>>> {
+        let mut out: Vec<Gaussian<T, D>> = Vec::with_capacity(steps);
+        for _ in 0..steps {
+            let next = match out.last() {
+                Some(prev) => self.predict(prev)?,
+                None => self.predict(state)?,
+            };
+            out.push(next);
+        }
+        Ok(out)
+    }
+}
+
+/// A prediction `N(x(k+1|k), P(k+1|k))` with the cross-covariance `Cov(x(k), x(k+1))`.
+pub type PredictionWithCross<T, D> = (Gaussian<T, D>, OMatrix<T, D, D>);
+
+/// The Rauch-Tung-Striebel smoother, for any filter that can say how one filtered state maps
+/// to the next prediction (for the KF `F P` and `F P F^T + Q`; for the UKF through sigma
+/// points).
+///
+/// For `k = N-2 .. 0`: `G = C(k) P(k+1|k)^-1`, `x_s(k) = x(k|k) + G (x_s(k+1) - x(k+1|k))`,
+/// `P_s(k) = P(k|k) + G (P_s(k+1) - P(k+1|k)) G^T`, where `C(k)` is the cross-covariance of
+/// `x(k)` and `x(k+1)`.
+pub trait Smoother<T: RealField + Copy, D: Dim, M: Dim>: Filter<T, D, M>
+where
+    DefaultAllocator: Allocator<D>
+        + Allocator<D, D>
+        + Allocator<M>
+        + Allocator<M, M>
+        + Allocator<D, M>
+        + Allocator<M, D>,
+{
+    /// The prediction from `filtered` and the cross-covariance `C = Cov(x(k), x(k+1))`.
+    fn prediction_with_cross_covariance(
+        &self,
+        filtered: &Gaussian<T, D>,
+    ) -> Result<PredictionWithCross<T, D>>;
+
+    /// Smooths filtered estimates (e.g. the posteriors of [`Filter::filter`]'s steps, in
+    /// time order). Errors with [`KalmanError::Empty`] for no states.
+    fn smooth(&self, filtered: &[Gaussian<T, D>]) -> Result<Vec<Gaussian<T, D>>> {
+        if filtered.is_empty() {
+            return Err(KalmanError::Empty {
+                what: "filtered states",
+            });
+        }
+        let mut out: Vec<Gaussian<T, D>> = filtered.to_vec();
+        for k in (0..filtered.len().saturating_sub(1)).rev() {
+            let (pred, cross) = self.prediction_with_cross_covariance(&filtered[k])?;
+            let chol = cholesky(pred.covariance.clone(), "P(k+1|k)")?;
+            // G^T = P(k+1|k)^-1 C^T, since P(k+1|k) is symmetric
+            let gain = chol.solve(&cross.transpose()).transpose();
+            let next = &out[k + 1];
+            let dx = &next.mean - &pred.mean;
+            let dp = &next.covariance - &pred.covariance;
+            let mean = &filtered[k].mean + &gain * dx;
+            let mut cov = &filtered[k].covariance + &gain * dp * gain.transpose();
+            symmetrise(&mut cov);
+            check_finite(&mean, "smoothed mean")?;
+            check_finite(&cov, "smoothed covariance")?;
+            out[k] = Gaussian {
+                mean,
+                covariance: cov,
+            };
+        }
+        Ok(out)
+    }
+
+    /// Filters and smooths a sequence in one call.
+    fn filter_smooth(
+        &self,
+        initial: &Gaussian<T, D>,
+        observations: &[Option<OVector<T, M>>],
+    ) -> Result<Vec<Gaussian<T, D>>> {
+        let steps = self.filter(initial, observations)?;
+        let filtered: Vec<Gaussian<T, D>> = steps.iter().map(|s| s.posterior().clone()).collect();
+        self.smooth(&filtered)
+    }
+}
+
+/// The prediction of a linearised model: mean given, `P' = F P F^T + Q`, symmetrised.
+pub(crate) fn linearized_predict<T, D>(
+    mean: OVector<T, D>,
+    f: &OMatrix<T, D, D>,
+    state: &Gaussian<T, D>,
+    q: &OMatrix<T, D, D>,
+) -> Result<Gaussian<T, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    let n = state.mean.nrows();
+    check_dim("F rows", n, f.nrows())?;
+    check_dim("F columns", n, f.ncols())?;
+    let mut p = f * &state.covariance * f.transpose() + q;
+    symmetrise(&mut p);
+    check_finite(&mean, "predicted mean")?;
+    check_finite(&p, "predicted covariance")?;
+    Ok(Gaussian {
+        mean,
+        covariance: p,
+    })
+}
+
+/// The update of a linearised observation model: `S = H P H^T + R`, `K = P H^T S^-1` by a
+/// Cholesky solve, `x + K y`, covariance by `form`, log-likelihood from the same factor.
+pub(crate) fn linearized_update<T, D, M, Ob>(
+    observation: &Ob,
+    prior: &Gaussian<T, D>,
+    predicted_z: &OVector<T, M>,
+    h: &OMatrix<T, M, D>,
+    z: &OVector<T, M>,
+    form: CovarianceUpdate,
+) -> Result<Update<T, D, M>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    Ob: Observation<T, D, M> + ?Sized,
+    DefaultAllocator: Allocator<D>
+        + Allocator<D, D>
+        + Allocator<M>
+        + Allocator<M, M>
+        + Allocator<D, M>
+        + Allocator<M, D>,
+{
+    let n = prior.mean.nrows();
+    let m = observation.observation_dim();
+    check_dim("observation", m, z.nrows())?;
+    check_finite(z, "observation")?;
+    check_dim("H rows", m, h.nrows())?;
+    check_dim("H columns", n, h.ncols())?;
+    check_dim("h(x)", m, predicted_z.nrows())?;
+    let r = observation.observation_noise();
+    let p = &prior.covariance;
+    let hp = h * p;
+    let mut s = &hp * h.transpose() + r;
+    symmetrise(&mut s);
+    let chol = cholesky(s.clone(), "S")?;
+    // K^T = S^-1 H P (P symmetric)
+    let gain = chol.solve(&hp).transpose();
+    let y = observation.observation_residual(z, predicted_z);
+    let mean = &prior.mean + &gain * &y;
+    let mut cov = match form {
+        CovarianceUpdate::Joseph => {
+            let mut ikh = -(&gain * h);
+            for i in 0..n {
+                ikh[(i, i)] += T::one();
+            }
+            let mut c = &ikh * p * ikh.transpose() + &gain * r * gain.transpose();
+            symmetrise(&mut c);
+            c
+        }
+        CovarianceUpdate::Plain | CovarianceUpdate::Symmetrised => p - &gain * &hp,
+    };
+    if form == CovarianceUpdate::Symmetrised {
+        symmetrise(&mut cov);
+    }
+    let log_likelihood = gaussian_log_likelihood(&chol, &y);
+    check_finite(&mean, "posterior mean")?;
+    check_finite(&cov, "posterior covariance")?;
+    if !log_likelihood.is_finite() {
+        return Err(KalmanError::NonFinite {
+            what: "log-likelihood",
+            index: 0,
+        });
+    }
+    Ok(Update {
+        posterior: Gaussian {
+            mean,
+            covariance: cov,
+        },
+        innovation: y,
+        innovation_covariance: s,
+        gain,
+        log_likelihood,
+    })
+}
+
+/// `ln N(y; 0, S)` from the Cholesky factor of `S`.
+pub(crate) fn gaussian_log_likelihood<T, M>(chol: &nalgebra::Cholesky<T, M>, y: &OVector<T, M>) -> T
+where
+    T: RealField + Copy,
+    M: Dim,
+    DefaultAllocator: Allocator<M> + Allocator<M, M>,
+{
+    let mut w = y.clone();
+    chol.l_dirty().solve_lower_triangular_unchecked_mut(&mut w);
+    let m = nalgebra::convert::<f64, T>(y.nrows() as f64);
+    let half = nalgebra::convert::<f64, T>(0.5);
+    -half * (m * T::two_pi().ln() + log_det(chol) + w.norm_squared())
+}
+
+/// Validates a state against the transition's dimension (shared by every filter's steps).
+pub(crate) fn validate_state<T, D>(state: &Gaussian<T, D>, n: usize) -> Result<()>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    check_state(state, n)
+}

@@ -1,0 +1,249 @@
+//! The linear Kalman filter [`Kf`] and the extended Kalman filter [`Ekf`]: one linearised
+//! predict/update code path, the KF with constant `F`, `H`, the EKF with `f`, `h` and their
+//! Jacobians evaluated at the current estimate.
+
+use crate::error::Result;
+use crate::filter::{
+    CovarianceUpdate, Filter, PredictionWithCross, Smoother, Update, linearized_predict,
+    linearized_update, validate_state,
+};
+use crate::linalg::check_dim;
+use crate::model::{
+    LinearObservationModel, LinearTransitionModel, ObservationJacobian, TransitionJacobian,
+    validate_models,
+};
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim, OVector, RealField};
+use trajpred_core::Gaussian;
+
+/// The linear Kalman filter.
+///
+/// Predict: `x(k|k-1) = F x(k-1|k-1)`, `P(k|k-1) = F P F^T + Q`.
+/// Update: `y = z - H x`, `S = H P H^T + R`, `K = P H^T S^-1` (Cholesky solve, no inverse),
+/// `x(k|k) = x + K y`, `P(k|k)` by the [`CovarianceUpdate`] form (Joseph by default).
+///
+/// ```
+/// use nalgebra::{Matrix1, Matrix1x2, Matrix2, Vector1, Vector2};
+/// use trajpred_core::Gaussian;
+/// use trajpred_kalman::{Filter, Kf, LinearObservation, LinearTransition};
+/// let tr = LinearTransition::new(Matrix2::new(1.0, 1.0, 0.0, 1.0), Matrix2::identity() * 1e-3)?;
+/// let ob = LinearObservation::new(Matrix1x2::new(1.0, 0.0), Matrix1::new(0.25))?;
+/// let kf = Kf::new(tr, ob)?;
+/// let x0 = Gaussian { mean: Vector2::new(0.0, 1.0), covariance: Matrix2::identity() };
+/// let step = kf.step(&x0, Some(&Vector1::new(1.1)))?;
+/// assert!(step.posterior().covariance[(0, 0)] < step.prior.covariance[(0, 0)]);
+/// # Ok::<(), trajpred_kalman::KalmanError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct Kf<Tr, Ob> {
+    transition: Tr,
+    observation: Ob,
+    covariance_update: CovarianceUpdate,
+}
+
+impl<Tr, Ob> Kf<Tr, Ob> {
+    /// A KF from a linear transition (F, Q) and a linear observation (H, R), with the
+    /// Joseph-form covariance update. Checks `Q` (positive semi-definite) and `R` (positive
+    /// definite) once here.
+    pub fn new<T, D, M>(transition: Tr, observation: Ob) -> Result<Self>
+    where
+        T: RealField + Copy,
+        D: Dim,
+        M: Dim,
+        Tr: LinearTransitionModel<T, D>,
+        Ob: LinearObservationModel<T, D, M>,
+        DefaultAllocator:
+            Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M> + Allocator<M, D>,
+    {
+        validate_models(&transition, &observation)?;
+        check_dim(
+            "H columns",
+            transition.state_dim(),
+            observation.observation_matrix().ncols(),
+        )?;
+        Ok(Kf {
+            transition,
+            observation,
+            covariance_update: CovarianceUpdate::Joseph,
+        })
+    }
+
+    /// Selects the covariance update form.
+    pub fn with_covariance_update(mut self, form: CovarianceUpdate) -> Self {
+        self.covariance_update = form;
+        self
+    }
+
+    /// The covariance update form in use.
+    pub fn covariance_update(&self) -> CovarianceUpdate {
+        self.covariance_update
+    }
+
+    /// The transition model.
+    pub fn transition(&self) -> &Tr {
+        &self.transition
+    }
+
+    /// The observation model.
+    pub fn observation(&self) -> &Ob {
+        &self.observation
+    }
+}
+
+impl<T, D, M, Tr, Ob> Filter<T, D, M> for Kf<Tr, Ob>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    Tr: LinearTransitionModel<T, D>,
+    Ob: LinearObservationModel<T, D, M>,
+    DefaultAllocator: Allocator<D>
+        + Allocator<D, D>
+        + Allocator<M>
+        + Allocator<M, M>
+        + Allocator<D, M>
+        + Allocator<M, D>,
+{
+    fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
+        validate_state(state, self.transition.state_dim())?;
+        let f = self.transition.transition_matrix();
+        let mean = f * &state.mean;
+        linearized_predict(mean, f, state, self.transition.process_noise())
+    }
+
+    fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>> {
+        validate_state(prior, self.transition.state_dim())?;
+        let h = self.observation.observation_matrix();
+        let zp = h * &prior.mean;
+        linearized_update(&self.observation, prior, &zp, h, z, self.covariance_update)
+    }
+}
+
+impl<T, D, M, Tr, Ob> Smoother<T, D, M> for Kf<Tr, Ob>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    Tr: LinearTransitionModel<T, D>,
+    Ob: LinearObservationModel<T, D, M>,
+    DefaultAllocator: Allocator<D>
+        + Allocator<D, D>
+        + Allocator<M>
+        + Allocator<M, M>
+        + Allocator<D, M>
+        + Allocator<M, D>,
+{
+    fn prediction_with_cross_covariance(
+        &self,
+        filtered: &Gaussian<T, D>,
+    ) -> Result<PredictionWithCross<T, D>> {
+        let pred = self.predict(filtered)?;
+        let cross = &filtered.covariance * self.transition.transition_matrix().transpose();
+        Ok((pred, cross))
+    }
+}
+
+/// The extended Kalman filter: nonlinear transition **and** observation, each linearised at
+/// the current estimate.
+///
+/// Predict: `x(k|k-1) = f(x)`, `P(k|k-1) = F(x) P F(x)^T + Q` with `F = df/dx` at
+/// `x(k-1|k-1)`. Update: `y = residual(z, h(x))`, `H = dh/dx` at `x(k|k-1)`, then as the KF
+/// (same code). filterpy's `ExtendedKalmanFilter` linearises only `h`; here both are.
+#[derive(Debug, Clone)]
+pub struct Ekf<Tr, Ob> {
+    transition: Tr,
+    observation: Ob,
+    covariance_update: CovarianceUpdate,
+}
+
+impl<Tr, Ob> Ekf<Tr, Ob> {
+    /// An EKF from models with Jacobians; checks `Q` and `R` once here.
+    pub fn new<T, D, M>(transition: Tr, observation: Ob) -> Result<Self>
+    where
+        T: RealField + Copy,
+        D: Dim,
+        M: Dim,
+        Tr: TransitionJacobian<T, D>,
+        Ob: ObservationJacobian<T, D, M>,
+        DefaultAllocator:
+            Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M> + Allocator<M, D>,
+    {
+        validate_models(&transition, &observation)?;
+        Ok(Ekf {
+            transition,
+            observation,
+            covariance_update: CovarianceUpdate::Joseph,
+        })
+    }
+
+    /// Selects the covariance update form.
+    pub fn with_covariance_update(mut self, form: CovarianceUpdate) -> Self {
+        self.covariance_update = form;
+        self
+    }
+
+    /// The transition model.
+    pub fn transition(&self) -> &Tr {
+        &self.transition
+    }
+
+    /// The observation model.
+    pub fn observation(&self) -> &Ob {
+        &self.observation
+    }
+}
+
+impl<T, D, M, Tr, Ob> Filter<T, D, M> for Ekf<Tr, Ob>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    Tr: TransitionJacobian<T, D>,
+    Ob: ObservationJacobian<T, D, M>,
+    DefaultAllocator: Allocator<D>
+        + Allocator<D, D>
+        + Allocator<M>
+        + Allocator<M, M>
+        + Allocator<D, M>
+        + Allocator<M, D>,
+{
+    fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
+        let n = self.transition.state_dim();
+        validate_state(state, n)?;
+        let mean = self.transition.transition(&state.mean)?;
+        check_dim("f(x)", n, mean.nrows())?;
+        let f = self.transition.transition_jacobian(&state.mean)?;
+        linearized_predict(mean, &f, state, self.transition.process_noise())
+    }
+
+    fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>> {
+        validate_state(prior, self.transition.state_dim())?;
+        let zp = self.observation.observe(&prior.mean)?;
+        let h = self.observation.observation_jacobian(&prior.mean)?;
+        linearized_update(&self.observation, prior, &zp, &h, z, self.covariance_update)
+    }
+}
+
+impl<T, D, M, Tr, Ob> Smoother<T, D, M> for Ekf<Tr, Ob>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    Tr: TransitionJacobian<T, D>,
+    Ob: ObservationJacobian<T, D, M>,
+    DefaultAllocator: Allocator<D>
+        + Allocator<D, D>
+        + Allocator<M>
+        + Allocator<M, M>
+        + Allocator<D, M>
+        + Allocator<M, D>,
+{
+    fn prediction_with_cross_covariance(
+        &self,
+        filtered: &Gaussian<T, D>,
+    ) -> Result<PredictionWithCross<T, D>> {
+        let pred = self.predict(filtered)?;
+        let f = self.transition.transition_jacobian(&filtered.mean)?;
+        Ok((pred, &filtered.covariance * f.transpose()))
+    }
+}

@@ -1,0 +1,476 @@
+//! Motion and sensor models: constant velocity and constant acceleration in 1-3 axes with
+//! the discrete white-noise `Q`, the coordinated turn ([`CoordinatedTurn`]) and the
+//! range-bearing sensor ([`RangeBearing`]).
+//!
+//! The kinematic models are generic over the state dimension type `D`: ask for a static
+//! size (`nalgebra::U4` for 2-D constant velocity) or `nalgebra::Dyn`; a static size that does
+//! not fit the number of axes is a [`KalmanError::DimensionMismatch`].
+
+use crate::error::{KalmanError, Result};
+use crate::linalg::{check_dim, check_pd, check_psd};
+use crate::model::{
+    LinearObservation, LinearTransition, Observation, ObservationJacobian, Transition,
+    TransitionJacobian,
+};
+use nalgebra::allocator::Allocator;
+use nalgebra::{
+    DefaultAllocator, Dim, Matrix2, Matrix5, OMatrix, OVector, RealField, U2, U5, Vector2, Vector5,
+};
+
+/// How the kinematic state of several axes is laid out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum StateOrder {
+    /// One block per axis: `[x, vx, y, vy]` (filterpy's order; `Q` block diagonal). Default.
+    #[default]
+    AxisBlocks,
+    /// All positions, then all velocities (then accelerations): `[x, y, vx, vy]`, the order
+    /// of the KF-dynamic paper (SPEC B.1).
+    PositionsFirst,
+}
+
+/// The layout of a kinematic state: `axes` axes, each with `derivatives` components
+/// (2: position and velocity; 3: and acceleration), ordered by `order`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct KinematicLayout {
+    /// Number of axes (1, 2 or 3).
+    pub axes: usize,
+    /// Components per axis (2 for constant velocity, 3 for constant acceleration).
+    pub derivatives: usize,
+    /// The ordering of the components.
+    pub order: StateOrder,
+}
+
+impl KinematicLayout {
+    /// A layout; errors with [`KalmanError::InvalidParameter`] unless `axes` is 1..=3 and
+    /// `derivatives` 2 or 3.
+    pub fn new(axes: usize, derivatives: usize, order: StateOrder) -> Result<Self> {
+        if !(1..=3).contains(&axes) {
+            return Err(KalmanError::InvalidParameter {
+                name: "axes",
+                reason: format!("must be 1, 2 or 3, got {axes}"),
+            });
+        }
+        if !(2..=3).contains(&derivatives) {
+            return Err(KalmanError::InvalidParameter {
+                name: "derivatives",
+                reason: format!("must be 2 (CV) or 3 (CA), got {derivatives}"),
+            });
+        }
+        Ok(KinematicLayout {
+            axes,
+            derivatives,
+            order,
+        })
+    }
+
+    /// The state dimension `axes * derivatives`.
+    pub fn state_dim(&self) -> usize {
+        self.axes * self.derivatives
+    }
+
+    /// The index in the state of derivative `derivative` (0 = position) of axis `axis`.
+    pub fn index(&self, axis: usize, derivative: usize) -> usize {
+        match self.order {
+            StateOrder::AxisBlocks => axis * self.derivatives + derivative,
+            StateOrder::PositionsFirst => derivative * self.axes + axis,
+        }
+    }
+}
+
+/// filterpy's `Q_discrete_white_noise(dim, dt, var)` block for one axis (dim 2 or 3):
+/// the piecewise-constant white-noise acceleration model.
+fn white_noise_block(derivatives: usize, dt: f64, var: f64) -> [[f64; 3]; 3] {
+    let (t2, t3, t4) = (dt * dt, dt * dt * dt, dt * dt * dt * dt);
+    if derivatives == 2 {
+        [
+            [t4 / 4.0 * var, t3 / 2.0 * var, 0.0],
+            [t3 / 2.0 * var, t2 * var, 0.0],
+            [0.0; 3],
+        ]
+    } else {
+        [
+            [t4 / 4.0 * var, t3 / 2.0 * var, t2 / 2.0 * var],
+            [t3 / 2.0 * var, t2 * var, dt * var],
+            [t2 / 2.0 * var, dt * var, var],
+        ]
+    }
+}
+
+fn check_positive(name: &'static str, v: f64, allow_zero: bool) -> Result<()> {
+    let ok = v.is_finite() && (v > 0.0 || (allow_zero && v == 0.0));
+    if ok {
+        Ok(())
+    } else {
+        Err(KalmanError::InvalidParameter {
+            name,
+            reason: format!(
+                "must be finite and {}, got {v}",
+                if allow_zero { ">= 0" } else { "> 0" }
+            ),
+        })
+    }
+}
+
+fn state_dim_type<D: Dim>(n: usize) -> Result<D> {
+    if let Some(s) = D::try_to_usize() {
+        check_dim("static state size vs axes", n, s)?;
+    }
+    Ok(D::from_usize(n))
+}
+
+/// The kinematic transition of `layout` for the time step `dt`, with the discrete
+/// white-noise process noise of variance `var` per axis (filterpy's
+/// `Q_discrete_white_noise`).
+pub fn kinematic<T, D>(layout: KinematicLayout, dt: f64, var: f64) -> Result<LinearTransition<T, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    check_positive("dt", dt, false)?;
+    check_positive("var", var, true)?;
+    let n = layout.state_dim();
+    let d: D = state_dim_type(n)?;
+    let k = layout.derivatives;
+    let block_f = |i: usize, j: usize| -> f64 {
+        // F block: [[1, dt, dt^2/2], [0, 1, dt], [0, 0, 1]]
+        if j < i {
+            0.0
+        } else {
+            let p = (j - i) as i32;
+            dt.powi(p) / if p == 2 { 2.0 } else { 1.0 }
+        }
+    };
+    let q_block = white_noise_block(k, dt, var);
+    let mut f = OMatrix::<T, D, D>::zeros_generic(d, d);
+    let mut q = OMatrix::<T, D, D>::zeros_generic(d, d);
+    for axis in 0..layout.axes {
+        for (i, q_row) in q_block.iter().enumerate().take(k) {
+            for (j, &qv) in q_row.iter().enumerate().take(k) {
+                let (r, c) = (layout.index(axis, i), layout.index(axis, j));
+                f[(r, c)] = nalgebra::convert(block_f(i, j));
+                q[(r, c)] = nalgebra::convert(qv);
+            }
+        }
+    }
+    LinearTransition::new(f, q)
+}
+
+/// Constant velocity in `axes` axes (state `2 * axes`) for the time step `dt` and the
+/// white-noise acceleration variance `var`.
+///
+/// ```
+/// use nalgebra::{Vector4, U4};
+/// use trajpred_kalman::{motion::{constant_velocity, StateOrder}, Transition};
+/// let cv = constant_velocity::<f64, U4>(2, 0.5, 1.0, StateOrder::PositionsFirst)?;
+/// // [x, y, vx, vy] = [0, 0, 2, -2] moves to [1, -1, 2, -2] in 0.5 s
+/// assert_eq!(cv.transition(&Vector4::new(0.0, 0.0, 2.0, -2.0))?, Vector4::new(1.0, -1.0, 2.0, -2.0));
+/// # Ok::<(), trajpred_kalman::KalmanError>(())
+/// ```
+pub fn constant_velocity<T, D>(
+    axes: usize,
+    dt: f64,
+    var: f64,
+    order: StateOrder,
+) -> Result<LinearTransition<T, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    kinematic(KinematicLayout::new(axes, 2, order)?, dt, var)
+}
+
+/// Constant acceleration in `axes` axes (state `3 * axes`) for the time step `dt` and the
+/// white-noise jerk variance `var`.
+pub fn constant_acceleration<T, D>(
+    axes: usize,
+    dt: f64,
+    var: f64,
+    order: StateOrder,
+) -> Result<LinearTransition<T, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    kinematic(KinematicLayout::new(axes, 3, order)?, dt, var)
+}
+
+/// The observation of the positions of a kinematic state (`m = axes`), with independent
+/// noise of variance `var` per axis: `R = var I`.
+pub fn position_observation<T, D, M>(
+    layout: KinematicLayout,
+    var: f64,
+) -> Result<LinearObservation<T, D, M>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    DefaultAllocator:
+        Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M> + Allocator<M, D>,
+{
+    check_positive("var", var, false)?;
+    let d: D = state_dim_type(layout.state_dim())?;
+    if let Some(s) = M::try_to_usize() {
+        check_dim("static observation size vs axes", layout.axes, s)?;
+    }
+    let m = M::from_usize(layout.axes);
+    let mut h = OMatrix::<T, M, D>::zeros_generic(m, d);
+    for axis in 0..layout.axes {
+        h[(axis, layout.index(axis, 0))] = T::one();
+    }
+    let r = OMatrix::<T, M, M>::identity_generic(m, m) * nalgebra::convert::<f64, T>(var);
+    LinearObservation::new(h, r)
+}
+
+// ---- coordinated turn -----------------------------------------------------------------------
+
+/// The coordinated turn with unknown turn rate: state `[x, vx, y, vy, omega]`
+/// (positions, velocities, turn rate in rad/s), time step `dt`:
+///
+/// ```text
+/// x'  = x + sin(w T)/w vx - (1 - cos(w T))/w vy      vx' = cos(w T) vx - sin(w T) vy
+/// y'  = y + (1 - cos(w T))/w vx + sin(w T)/w vy      vy' = sin(w T) vx + cos(w T) vy
+/// w'  = w
+/// ```
+///
+/// with the limits `sin(wT)/w -> T`, `(1 - cos(wT))/w -> 0` as `w -> 0` (a series is used for
+/// `|w T| < 1e-4`, so the model and its Jacobian are smooth through straight flight).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CoordinatedTurn<T: RealField> {
+    dt: T,
+    q: Matrix5<T>,
+}
+
+impl<T: RealField + Copy> CoordinatedTurn<T> {
+    /// The model with Bar-Shalom's noise: white acceleration of variance `accel_var` on each
+    /// axis (blocks `[[T^4/4, T^3/2], [T^3/2, T^2]] accel_var`) and a turn-rate increment of
+    /// variance `T^2 turn_rate_var`.
+    pub fn new(dt: f64, accel_var: f64, turn_rate_var: f64) -> Result<Self> {
+        check_positive("dt", dt, false)?;
+        check_positive("accel_var", accel_var, true)?;
+        check_positive("turn_rate_var", turn_rate_var, true)?;
+        let b = white_noise_block(2, dt, accel_var);
+        let mut q = Matrix5::<T>::zeros();
+        for o in [0usize, 2] {
+            for (i, row) in b.iter().enumerate().take(2) {
+                for (j, &v) in row.iter().enumerate().take(2) {
+                    q[(o + i, o + j)] = nalgebra::convert(v);
+                }
+            }
+        }
+        q[(4, 4)] = nalgebra::convert(dt * dt * turn_rate_var);
+        Self::with_process_noise(dt, q)
+    }
+
+    /// The model with any process noise `Q` (symmetric positive semi-definite).
+    pub fn with_process_noise(dt: f64, q: Matrix5<T>) -> Result<Self> {
+        check_positive("dt", dt, false)?;
+        check_psd(&q, "Q")?;
+        Ok(CoordinatedTurn {
+            dt: nalgebra::convert(dt),
+            q,
+        })
+    }
+
+    /// `(sin(wT)/w, (1-cos(wT))/w, d/dw of both, cos(wT), sin(wT))`.
+    fn coefficients(&self, w: T) -> [T; 6] {
+        let t = self.dt;
+        let wt = w * t;
+        let (s, c) = (wt.sin(), wt.cos());
+        let k = |v: f64| nalgebra::convert::<f64, T>(v);
+        if wt.abs() < k(1e-4) {
+            let (t2, t3, t4) = (t * t, t * t * t, t * t * t * t);
+            let w2 = w * w;
+            [
+                t - w2 * t3 / k(6.0),
+                w * t2 / k(2.0) - w2 * w * t4 / k(24.0),
+                -w * t3 / k(3.0),
+                t2 / k(2.0) - w2 * t4 / k(8.0),
+                c,
+                s,
+            ]
+        } else {
+            let w2 = w * w;
+            [
+                s / w,
+                (T::one() - c) / w,
+                (wt * c - s) / w2,
+                (wt * s - T::one() + c) / w2,
+                c,
+                s,
+            ]
+        }
+    }
+}
+
+impl<T: RealField + Copy> Transition<T, U5> for CoordinatedTurn<T> {
+    fn transition(&self, x: &Vector5<T>) -> Result<Vector5<T>> {
+        let [a, b, _, _, c, s] = self.coefficients(x[4]);
+        let (vx, vy) = (x[1], x[3]);
+        Ok(Vector5::new(
+            x[0] + a * vx - b * vy,
+            c * vx - s * vy,
+            x[2] + b * vx + a * vy,
+            s * vx + c * vy,
+            x[4],
+        ))
+    }
+    fn process_noise(&self) -> &Matrix5<T> {
+        &self.q
+    }
+}
+
+impl<T: RealField + Copy> TransitionJacobian<T, U5> for CoordinatedTurn<T> {
+    fn transition_jacobian(&self, x: &Vector5<T>) -> Result<Matrix5<T>> {
+        let [a, b, da, db, c, s] = self.coefficients(x[4]);
+        let (vx, vy) = (x[1], x[3]);
+        let t = self.dt;
+        let (o, z) = (T::one(), T::zero());
+        Ok(Matrix5::new(
+            o,
+            a,
+            z,
+            -b,
+            da * vx - db * vy, //
+            z,
+            c,
+            z,
+            -s,
+            -t * (s * vx + c * vy), //
+            z,
+            b,
+            o,
+            a,
+            db * vx + da * vy, //
+            z,
+            s,
+            z,
+            c,
+            t * (c * vx - s * vy), //
+            z,
+            z,
+            z,
+            z,
+            o,
+        ))
+    }
+}
+
+// ---- range and bearing ----------------------------------------------------------------------
+
+/// Range and bearing of the target from a sensor at `(sx, sy)`:
+/// `h(x) = [sqrt(dx^2 + dy^2), atan2(dy, dx)]` with `dx = x[ix] - sx`, `dy = x[iy] - sy`.
+/// The bearing residual is wrapped into `[-pi, pi)`, and averaged bearings are wrapped back,
+/// so the filters handle targets crossing the `+-pi` line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RangeBearing<T: RealField> {
+    sensor: Vector2<T>,
+    x_index: usize,
+    y_index: usize,
+    r: Matrix2<T>,
+}
+
+impl<T: RealField + Copy> RangeBearing<T> {
+    /// A sensor at `sensor`, reading the target position from state components `x_index`
+    /// and `y_index`, with range variance `range_var` and bearing variance `bearing_var`
+    /// (rad^2).
+    pub fn new(
+        sensor: Vector2<T>,
+        x_index: usize,
+        y_index: usize,
+        range_var: f64,
+        bearing_var: f64,
+    ) -> Result<Self> {
+        check_positive("range_var", range_var, false)?;
+        check_positive("bearing_var", bearing_var, false)?;
+        let r = Matrix2::new(
+            nalgebra::convert(range_var),
+            T::zero(),
+            T::zero(),
+            nalgebra::convert(bearing_var),
+        );
+        check_pd(&r, "R")?;
+        if sensor.iter().any(|v| !v.is_finite()) {
+            return Err(KalmanError::NonFinite {
+                what: "sensor position",
+                index: sensor.iter().position(|v| !v.is_finite()).unwrap_or(0),
+            });
+        }
+        Ok(RangeBearing {
+            sensor,
+            x_index,
+            y_index,
+            r,
+        })
+    }
+
+    fn offsets<D: Dim>(&self, x: &OVector<T, D>) -> Result<(T, T)>
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        let need = self.x_index.max(self.y_index) + 1;
+        if x.nrows() < need {
+            return Err(KalmanError::DimensionMismatch {
+                what: "state too short for the position indices",
+                expected: need,
+                got: x.nrows(),
+            });
+        }
+        Ok((
+            x[self.x_index] - self.sensor.x,
+            x[self.y_index] - self.sensor.y,
+        ))
+    }
+}
+
+/// Wraps an angle into `[-pi, pi)`.
+pub fn wrap_angle<T: RealField + Copy>(a: T) -> T {
+    let two_pi = T::two_pi();
+    let r = (a + T::pi()) % two_pi;
+    let r = if r < T::zero() { r + two_pi } else { r };
+    r - T::pi()
+}
+
+impl<T: RealField + Copy, D: Dim> Observation<T, D, U2> for RangeBearing<T>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    fn observe(&self, x: &OVector<T, D>) -> Result<Vector2<T>> {
+        let (dx, dy) = self.offsets(x)?;
+        Ok(Vector2::new((dx * dx + dy * dy).sqrt(), dy.atan2(dx)))
+    }
+    fn observation_noise(&self) -> &Matrix2<T> {
+        &self.r
+    }
+    fn observation_residual(&self, a: &Vector2<T>, b: &Vector2<T>) -> Vector2<T> {
+        Vector2::new(a[0] - b[0], wrap_angle(a[1] - b[1]))
+    }
+    fn normalize_observation(&self, z: Vector2<T>) -> Vector2<T> {
+        Vector2::new(z[0], wrap_angle(z[1]))
+    }
+}
+
+impl<T: RealField + Copy, D: Dim> ObservationJacobian<T, D, U2> for RangeBearing<T>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<U2, D>,
+{
+    fn observation_jacobian(&self, x: &OVector<T, D>) -> Result<OMatrix<T, U2, D>> {
+        let (dx, dy) = self.offsets(x)?;
+        let r2 = dx * dx + dy * dy;
+        if r2 <= T::zero() || !r2.is_finite() {
+            return Err(KalmanError::Undefined {
+                what: "range-bearing Jacobian at the sensor position",
+            });
+        }
+        let r = r2.sqrt();
+        let d = x.shape_generic().0;
+        let mut h = OMatrix::<T, U2, D>::zeros_generic(nalgebra::Const::<2>, d);
+        h[(0, self.x_index)] = dx / r;
+        h[(0, self.y_index)] = dy / r;
+        h[(1, self.x_index)] = -dy / r2;
+        h[(1, self.y_index)] = dx / r2;
+        Ok(h)
+    }
+}

@@ -1,0 +1,387 @@
+//! The unscented Kalman filter [`Ukf`] with Merwe's scaled sigma points
+//! ([`MerweSigmaPoints`]) and additive noise, and the unscented RTS smoother.
+
+use crate::error::{KalmanError, Result};
+use crate::filter::{
+    Filter, PredictionWithCross, Smoother, Update, gaussian_log_likelihood, validate_state,
+};
+use crate::linalg::{check_dim, check_finite, cholesky, symmetrise};
+use crate::model::{Observation, Transition, validate_models};
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
+use trajpred_core::Gaussian;
+
+/// Merwe's scaled sigma points (SPEC C.1 eq. 10-11): for a state of dimension `n`,
+/// `lambda = alpha^2 (n + kappa) - n`, the `2n + 1` points `x`, `x + sqrt((n+lambda) P)_i`,
+/// `x - sqrt((n+lambda) P)_i` (columns of the lower Cholesky factor; filterpy's order),
+/// with weights `W0m = lambda / (n + lambda)`, `W0c = W0m + 1 - alpha^2 + beta`,
+/// `Wi = 1 / (2 (n + lambda))`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MerweSigmaPoints<T> {
+    /// Spread of the points around the mean (typically `1e-3 <= alpha <= 1`).
+    pub alpha: T,
+    /// Prior knowledge of the distribution (2 is optimal for a Gaussian).
+    pub beta: T,
+    /// Secondary scaling (typically 0 or `3 - n`).
+    pub kappa: T,
+}
+
+impl<T: RealField + Copy> MerweSigmaPoints<T> {
+    /// The parameters `alpha`, `beta`, `kappa` (checked by [`MerweSigmaPoints::weights`]).
+    pub fn new(alpha: T, beta: T, kappa: T) -> Self {
+        MerweSigmaPoints { alpha, beta, kappa }
+    }
+
+    /// The weights for a state of dimension `n`. Errors with
+    /// [`KalmanError::DegenerateSigmaPoints`] when a parameter is not finite, `alpha <= 0`
+    /// or `n + lambda = alpha^2 (n + kappa) <= 0` (the weights `1 / (2 (n + lambda))` would
+    /// be infinite or negative), and [`KalmanError::InvalidParameter`] for `n = 0`.
+    pub fn weights(&self, n: usize) -> Result<SigmaWeights<T>> {
+        if n == 0 {
+            return Err(KalmanError::InvalidParameter {
+                name: "n",
+                reason: "the state dimension must be at least 1".into(),
+            });
+        }
+        let nt = nalgebra::convert::<f64, T>(n as f64);
+        let lambda = self.alpha * self.alpha * (nt + self.kappa) - nt;
+        let c = nt + lambda;
+        let finite = self.alpha.is_finite() && self.beta.is_finite() && self.kappa.is_finite();
+        if !finite || self.alpha <= T::zero() || c <= T::zero() || !c.is_finite() {
+            return Err(KalmanError::DegenerateSigmaPoints {
+                n_plus_lambda: to_f64(c),
+                alpha: to_f64(self.alpha),
+                kappa: to_f64(self.kappa),
+                n,
+            });
+        }
+        let mean0 = lambda / c;
+        let other = T::one() / (c + c);
+        if !mean0.is_finite() || !other.is_finite() {
+            return Err(KalmanError::DegenerateSigmaPoints {
+                n_plus_lambda: to_f64(c),
+                alpha: to_f64(self.alpha),
+                kappa: to_f64(self.kappa),
+                n,
+            });
+        }
+        Ok(SigmaWeights {
+            n,
+            lambda,
+            mean0,
+            covariance0: mean0 + T::one() - self.alpha * self.alpha + self.beta,
+            other,
+        })
+    }
+
+    /// The `2n + 1` sigma points of `state` in filterpy's order (`x`, then `x + L_i`, then
+    /// `x - L_i`, with `L L^T = (n + lambda) P`). Errors if `P` is not positive definite.
+    pub fn sigma_points<D: Dim>(&self, state: &Gaussian<T, D>) -> Result<Vec<OVector<T, D>>>
+    where
+        DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    {
+        let n = state.mean.nrows();
+        let w = self.weights(n)?;
+        validate_state(state, n)?;
+        let l = w.spread(&state.covariance)?;
+        let mut out = Vec::with_capacity(2 * n + 1);
+        out.push(state.mean.clone());
+        for j in 0..n {
+            out.push(&state.mean + l.column(j));
+        }
+        for j in 0..n {
+            out.push(&state.mean - l.column(j));
+        }
+        Ok(out)
+    }
+}
+
+impl<T: RealField + Copy> Default for MerweSigmaPoints<T> {
+    /// `alpha = 1e-3`, `beta = 2`, `kappa = 0`: the typical values of SPEC C.1.
+    fn default() -> Self {
+        MerweSigmaPoints {
+            alpha: nalgebra::convert(1e-3),
+            beta: nalgebra::convert(2.0),
+            kappa: T::zero(),
+        }
+    }
+}
+
+fn to_f64<T: RealField + Copy>(v: T) -> f64 {
+    nalgebra::try_convert::<T, f64>(v).unwrap_or(f64::NAN)
+}
+
+/// The weights of Merwe's sigma points for one state dimension.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SigmaWeights<T> {
+    /// The state dimension `n`.
+    pub n: usize,
+    /// `lambda = alpha^2 (n + kappa) - n`.
+    pub lambda: T,
+    /// Mean weight of the central point `W0m = lambda / (n + lambda)`.
+    pub mean0: T,
+    /// Covariance weight of the central point `W0c = W0m + 1 - alpha^2 + beta`.
+    pub covariance0: T,
+    /// Weight of every other point (mean and covariance) `1 / (2 (n + lambda))`.
+    pub other: T,
+}
+
+impl<T: RealField + Copy> SigmaWeights<T> {
+    /// The `2n + 1` mean weights, in sigma-point order.
+    pub fn mean_weights(&self) -> Vec<T> {
+        let mut w = vec![self.other; 2 * self.n + 1];
+        w[0] = self.mean0;
+        w
+    }
+
+    /// The `2n + 1` covariance weights, in sigma-point order.
+    pub fn covariance_weights(&self) -> Vec<T> {
+        let mut w = vec![self.other; 2 * self.n + 1];
+        w[0] = self.covariance0;
+        w
+    }
+
+    /// `L` with `L L^T = (n + lambda) P` (lower Cholesky factor): its columns are the
+    /// sigma-point offsets.
+    fn spread<D: Dim>(&self, p: &OMatrix<T, D, D>) -> Result<OMatrix<T, D, D>>
+    where
+        DefaultAllocator: Allocator<D, D>,
+    {
+        let c = self.lambda + nalgebra::convert::<f64, T>(self.n as f64);
+        Ok(cholesky(p * c, "P")?.unpack())
+    }
+}
+
+/// The result of an unscented transform of `N(x, P)` through `g`: mean, covariance (without
+/// noise) and cross-covariance `Cov(x, g(x))`.
+struct Transformed<T: RealField, D: Dim, E: Dim>
+where
+    DefaultAllocator: Allocator<E> + Allocator<E, E> + Allocator<D, E>,
+{
+    mean: OVector<T, E>,
+    covariance: OMatrix<T, E, E>,
+    cross: OMatrix<T, D, E>,
+}
+
+/// The unscented transform with symmetric points: the mean is computed as
+/// `g(x) + sum_i Wi residual(g(x_i), g(x))` (equal to `sum_i Wm_i g(x_i)` for a linear
+/// residual, and a correct circular mean when `residual` wraps angles), the spread with
+/// `residual(g(x_i), mean)`.
+fn unscented_transform<T, D, E, G, R>(
+    state: &Gaussian<T, D>,
+    w: &SigmaWeights<T>,
+    g: G,
+    residual: R,
+) -> Result<Transformed<T, D, E>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    E: Dim,
+    G: Fn(&OVector<T, D>) -> Result<OVector<T, E>>,
+    R: Fn(&OVector<T, E>, &OVector<T, E>) -> OVector<T, E>,
+    DefaultAllocator: Allocator<D>
+        + Allocator<D, D>
+        + Allocator<E>
+        + Allocator<E, E>
+        + Allocator<E, D>
+        + Allocator<D, E>,
+{
+    let n = state.mean.nrows();
+    let l = w.spread(&state.covariance)?;
+    let y0 = g(&state.mean)?;
+    let e = y0.shape_generic().0;
+    let d = state.mean.shape_generic().0;
+    let mut plus = OMatrix::<T, E, D>::zeros_generic(e, d);
+    let mut minus = OMatrix::<T, E, D>::zeros_generic(e, d);
+    let mut sum = OVector::<T, E>::zeros_generic(e, nalgebra::Const::<1>);
+    for j in 0..n {
+        let xp = &state.mean + l.column(j);
+        let yp = g(&xp)?;
+        check_dim("transformed sigma point", e.value(), yp.nrows())?;
+        sum += residual(&yp, &y0);
+        plus.set_column(j, &yp);
+        let xm = &state.mean - l.column(j);
+        let ym = g(&xm)?;
+        check_dim("transformed sigma point", e.value(), ym.nrows())?;
+        sum += residual(&ym, &y0);
+        minus.set_column(j, &ym);
+    }
+    let mean = &y0 + sum * w.other;
+    let r0 = residual(&y0, &mean);
+    let mut covariance = OMatrix::<T, E, E>::zeros_generic(e, e);
+    covariance.ger(w.covariance0, &r0, &r0, T::zero());
+    let mut cross = OMatrix::<T, D, E>::zeros_generic(d, e);
+    for j in 0..n {
+        let rp = residual(&plus.column(j).into_owned(), &mean);
+        let rm = residual(&minus.column(j).into_owned(), &mean);
+        covariance.ger(w.other, &rp, &rp, T::one());
+        covariance.ger(w.other, &rm, &rm, T::one());
+        cross.ger(w.other, &l.column(j), &(rp - rm), T::one());
+    }
+    Ok(Transformed {
+        mean,
+        covariance,
+        cross,
+    })
+}
+
+/// The unscented Kalman filter with additive noise and Merwe's scaled sigma points.
+///
+/// Predict: sigma points of `N(x(k-1|k-1), P(k-1|k-1))` through `f`; `x(k|k-1)` their
+/// weighted mean, `P(k|k-1)` their weighted spread `+ Q`.
+/// Update: sigma points **regenerated from the prior** `N(x(k|k-1), P(k|k-1))` (as filterpy
+/// 2.0.0 does after its predict), through `h`; `z_hat` their mean, `S` their spread `+ R`,
+/// `Pxz` the cross-covariance, `K = Pxz S^-1` (Cholesky solve), `x + K y`,
+/// `P - K S K^T` (symmetrised).
+///
+/// The weights are computed once, at construction, for the transition's state size; a
+/// parameter set with degenerate weights is rejected there.
+#[derive(Debug, Clone)]
+pub struct Ukf<T, Tr, Ob> {
+    transition: Tr,
+    observation: Ob,
+    points: MerweSigmaPoints<T>,
+    weights: SigmaWeights<T>,
+}
+
+impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
+    /// A UKF from a transition (`f`, `Q`), an observation (`h`, `R`) and sigma-point
+    /// parameters. Errors: [`KalmanError::DegenerateSigmaPoints`], and the model checks of
+    /// `Q` and `R`.
+    pub fn new<D, M>(transition: Tr, observation: Ob, points: MerweSigmaPoints<T>) -> Result<Self>
+    where
+        D: Dim,
+        M: Dim,
+        Tr: Transition<T, D>,
+        Ob: Observation<T, D, M>,
+        DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M>,
+    {
+        validate_models(&transition, &observation)?;
+        let weights = points.weights(transition.state_dim())?;
+        Ok(Ukf {
+            transition,
+            observation,
+            points,
+            weights,
+        })
+    }
+
+    /// The sigma-point parameters.
+    pub fn points(&self) -> &MerweSigmaPoints<T> {
+        &self.points
+    }
+
+    /// The sigma-point weights for this filter's state size.
+    pub fn weights(&self) -> &SigmaWeights<T> {
+        &self.weights
+    }
+
+    /// The transition model.
+    pub fn transition(&self) -> &Tr {
+        &self.transition
+    }
+
+    /// The observation model.
+    pub fn observation(&self) -> &Ob {
+        &self.observation
+    }
+}
+
+impl<T, D, M, Tr, Ob> Filter<T, D, M> for Ukf<T, Tr, Ob>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    Tr: Transition<T, D>,
+    Ob: Observation<T, D, M>,
+    DefaultAllocator: Allocator<D>
+        + Allocator<D, D>
+        + Allocator<M>
+        + Allocator<M, M>
+        + Allocator<D, M>
+        + Allocator<M, D>,
+{
+    fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
+        self.prediction_with_cross_covariance(state).map(|(g, _)| g)
+    }
+
+    fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>> {
+        let n = self.transition.state_dim();
+        validate_state(prior, n)?;
+        let m = self.observation.observation_dim();
+        check_dim("observation", m, z.nrows())?;
+        check_finite(z, "observation")?;
+        let ob = &self.observation;
+        let t = unscented_transform(
+            prior,
+            &self.weights,
+            |x| ob.observe(x),
+            |a, b| ob.observation_residual(a, b),
+        )?;
+        check_dim("h(x)", m, t.mean.nrows())?;
+        let z_hat = ob.normalize_observation(t.mean);
+        let mut s = t.covariance + ob.observation_noise();
+        symmetrise(&mut s);
+        let chol = cholesky(s.clone(), "S")?;
+        let gain = chol.solve(&t.cross.transpose()).transpose();
+        let y = ob.observation_residual(z, &z_hat);
+        let mean = &prior.mean + &gain * &y;
+        let mut cov = &prior.covariance - &gain * &s * gain.transpose();
+        symmetrise(&mut cov);
+        let log_likelihood = gaussian_log_likelihood(&chol, &y);
+        check_finite(&mean, "posterior mean")?;
+        check_finite(&cov, "posterior covariance")?;
+        Ok(Update {
+            posterior: Gaussian {
+                mean,
+                covariance: cov,
+            },
+            innovation: y,
+            innovation_covariance: s,
+            gain,
+            log_likelihood,
+        })
+    }
+}
+
+impl<T, D, M, Tr, Ob> Smoother<T, D, M> for Ukf<T, Tr, Ob>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    Tr: Transition<T, D>,
+    Ob: Observation<T, D, M>,
+    DefaultAllocator: Allocator<D>
+        + Allocator<D, D>
+        + Allocator<M>
+        + Allocator<M, M>
+        + Allocator<D, M>
+        + Allocator<M, D>,
+{
+    fn prediction_with_cross_covariance(
+        &self,
+        filtered: &Gaussian<T, D>,
+    ) -> Result<PredictionWithCross<T, D>> {
+        let n = self.transition.state_dim();
+        validate_state(filtered, n)?;
+        let tr = &self.transition;
+        let t = unscented_transform(
+            filtered,
+            &self.weights,
+            |x| tr.transition(x),
+            |a, b| tr.state_residual(a, b),
+        )?;
+        check_dim("f(x)", n, t.mean.nrows())?;
+        let mut p = t.covariance + tr.process_noise();
+        symmetrise(&mut p);
+        check_finite(&t.mean, "predicted mean")?;
+        check_finite(&p, "predicted covariance")?;
+        Ok((
+            Gaussian {
+                mean: t.mean,
+                covariance: p,
+            },
+            t.cross,
+        ))
+    }
+}
