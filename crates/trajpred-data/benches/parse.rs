@@ -1,0 +1,2 @@
+//! Parsing throughput.
+fn main() {}
