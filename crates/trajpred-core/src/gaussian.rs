@@ -16,7 +16,7 @@ use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
 /// ```
 /// use nalgebra::{Matrix2, Vector2};
 /// use trajpred_core::Gaussian;
-/// let g = Gaussian::new(Vector2::new(1.0, 2.0), Matrix2::new(4.0, 0.0, 0.0, 1.0))?;
+/// let g = Gaussian::new(Vector2::new(1.0f64, 2.0), Matrix2::new(4.0, 0.0, 0.0, 1.0))?;
 /// // squared Mahalanobis distance of (3, 2): (2^2)/4 = 1
 /// assert!((g.mahalanobis_squared(&Vector2::new(3.0, 2.0))? - 1.0).abs() < 1e-12);
 /// # Ok::<(), trajpred_core::Error>(())

@@ -108,14 +108,16 @@ impl Forecast {
 
     /// The predicted points, step 1 first.
     pub fn points(&self) -> impl ExactSizeIterator<Item = Point> + '_ {
-        self.means.chunks_exact(self.dim).map(|c| {
-            Point::new(c).unwrap_or_else(|_| unreachable!("dim checked at construction"))
-        })
+        self.means
+            .chunks_exact(self.dim)
+            .map(|c| Point::new(c).unwrap_or_else(|_| unreachable!("dim checked at construction")))
     }
 
     /// The covariance of the prediction `k` steps ahead, if the method provides one.
     pub fn covariance(&self, k: usize) -> Option<&DMatrix<f64>> {
-        self.covariances.as_ref().and_then(|c| c.get(k.checked_sub(1)?))
+        self.covariances
+            .as_ref()
+            .and_then(|c| c.get(k.checked_sub(1)?))
     }
 }
 

@@ -240,7 +240,11 @@ impl Trajectory {
         }
         Ok(Trajectory {
             times: self.times[range.clone()].to_vec(),
-            axes: self.axes.iter().map(|a| a[range.clone()].to_vec()).collect(),
+            axes: self
+                .axes
+                .iter()
+                .map(|a| a[range.clone()].to_vec())
+                .collect(),
         })
     }
 
