@@ -1,0 +1,837 @@
+//! Least angle regression: the LAR path and its lasso modification (Efron, Hastie,
+//! Johnstone, Tibshirani 2004), with a validating builder ([`LarsParams`]) and the whole
+//! fitted path ([`Lars`]).
+
+use crate::cholesky::{Append, CholeskyFactor, dot};
+use crate::error::{Error, Result};
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+/// Which path to compute.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Method {
+    /// Plain least angle regression: variables only enter; the end of the full path is the
+    /// least-squares fit. The sign `s_j` of an active variable is the sign of its correlation
+    /// when it entered and never changes, even when its coefficient crosses zero.
+    #[default]
+    Lar,
+    /// The lasso modification: a variable whose coefficient reaches zero is dropped from the
+    /// active set at that point, so the path is the lasso solution path.
+    Lasso,
+}
+
+/// When to use the precomputed Gram matrix `X^T X` (p x p) instead of passes over `X`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Gram {
+    /// Precompute when `p <= n` and `p <= 4096` (the Gram matrix then costs less than the
+    /// passes over `X` a full path needs, and at most 128 MiB).
+    #[default]
+    Auto,
+    /// Always precompute `X^T X`.
+    Precompute,
+    /// Never: every step does two passes over `X` (for wide or very large designs).
+    Never,
+}
+
+/// Why a column never entered the path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ExclusionReason {
+    /// The column is constant (zero after centring; exactly zero without an intercept).
+    ZeroVariance,
+    /// When it tied for the largest correlation, the column lay in the span of the active
+    /// columns (an exact or numerical duplicate or linear combination), so it cannot change
+    /// the fit; it is dropped for good, as in R's `lars`.
+    Collinear,
+}
+
+/// A column that is kept out of the path, and why.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Exclusion {
+    /// Column index (0-based, as in the input).
+    pub feature: usize,
+    /// Why it is excluded.
+    pub reason: ExclusionReason,
+    /// Step during which it was excluded (0 for zero-variance columns, found before the path).
+    pub step: usize,
+}
+
+/// One change of the active set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum PathEvent {
+    /// `feature` entered the active set at the start of step `step` (1-based), that is at knot
+    /// `step - 1`.
+    Added {
+        /// Column index.
+        feature: usize,
+        /// Step number (1-based).
+        step: usize,
+    },
+    /// Lasso only: `feature`'s coefficient reached zero at the end of step `step`, i.e. at
+    /// knot `step`, and it left the active set.
+    Dropped {
+        /// Column index.
+        feature: usize,
+        /// Step number (1-based).
+        step: usize,
+    },
+}
+
+/// Why the path ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum StopReason {
+    /// Every usable column is active and the last knot is the least-squares fit on them.
+    Complete,
+    /// The largest residual correlation vanished (relative to its starting value) before all
+    /// columns entered: the residual is orthogonal to every column (for instance `p > n`
+    /// after `rank(X)` steps, or an exactly representable target).
+    CorrelationVanished,
+    /// The requested number of steps was taken.
+    MaxSteps,
+    /// The path reached `alpha_min`; the last knot is interpolated to exactly `alpha_min`.
+    AlphaMin,
+    /// The equiangular direction could not be computed (the active Gram matrix is numerically
+    /// singular despite the collinearity check); the path ends at the last good knot.
+    NumericalBreakdown,
+}
+
+/// Builder of a LARS fit; validates its parameters and the data in [`LarsParams::fit`].
+///
+/// Defaults: [`Method::Lar`], intercept fitted, columns centred and scaled to unit L2 norm
+/// (SPEC A.2), full path, `alpha_min = 0`, tie tolerance `1e-12`, collinearity tolerance
+/// `1e-12`, vanishing-correlation tolerance `1e-12`.
+///
+/// ```
+/// use nalgebra::DMatrix;
+/// use trajpred_sparse::{Lars, Method, Error};
+/// let x = DMatrix::from_row_slice(4, 2, &[1.0, 0.0, 2.0, 1.0, 3.0, 0.0, 4.0, 2.0]);
+/// let y = [1.0, 3.0, 3.0, 6.0];
+/// let fit = Lars::params().method(Method::Lasso).fit(&x, &y)?;
+/// // the full path ends at least squares: y = 0 + 1 * x1 + 1 * x2 fits exactly
+/// assert!((fit.predict_row(&[5.0, 1.0])? - 6.0).abs() < 1e-9);
+/// // bad parameters are typed errors
+/// assert!(matches!(Lars::params().alpha_min(-1.0).fit(&x, &y), Err(Error::InvalidParameter { .. })));
+/// # Ok::<(), Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LarsParams {
+    method: Method,
+    fit_intercept: bool,
+    normalize: bool,
+    max_steps: Option<usize>,
+    alpha_min: f64,
+    tie_tolerance: f64,
+    collinearity_tolerance: f64,
+    vanish_tolerance: f64,
+    gram: Gram,
+}
+
+impl Default for LarsParams {
+    fn default() -> Self {
+        LarsParams {
+            method: Method::Lar,
+            fit_intercept: true,
+            normalize: true,
+            max_steps: None,
+            alpha_min: 0.0,
+            tie_tolerance: 1e-12,
+            collinearity_tolerance: 1e-12,
+            vanish_tolerance: 1e-12,
+            gram: Gram::Auto,
+        }
+    }
+}
+
+impl LarsParams {
+    /// LAR or lasso.
+    pub fn method(mut self, method: Method) -> Self {
+        self.method = method;
+        self
+    }
+
+    /// Fit an intercept (centre the columns and the target). Default `true`.
+    pub fn fit_intercept(mut self, yes: bool) -> Self {
+        self.fit_intercept = yes;
+        self
+    }
+
+    /// Scale every (centred, if `fit_intercept`) column to unit L2 norm before the path.
+    /// Default `true`. Alphas and [`Lars::standardized_coef_path`] refer to the scaled
+    /// problem; [`Lars::coef_path`] is always on the original scale.
+    pub fn normalize(mut self, yes: bool) -> Self {
+        self.normalize = yes;
+        self
+    }
+
+    /// Stop after `steps` steps (a step moves from one knot to the next; the path then has at
+    /// most `steps + 1` knots). Default: no limit.
+    pub fn max_steps(mut self, steps: usize) -> Self {
+        self.max_steps = Some(steps);
+        self
+    }
+
+    /// Stop when alpha (the largest absolute residual correlation divided by the number of
+    /// rows, scikit-learn's convention) reaches `alpha_min`; the last knot is interpolated
+    /// to exactly `alpha_min`. Default `0` (no stop). Must be finite and non-negative.
+    pub fn alpha_min(mut self, alpha: f64) -> Self {
+        self.alpha_min = alpha;
+        self
+    }
+
+    /// Variables whose absolute correlation is within `tol * C` of the maximum `C` enter
+    /// together at the same knot (R `lars`'s rule). Default `1e-12`, in `[0, 1e-3]`.
+    pub fn tie_tolerance(mut self, tol: f64) -> Self {
+        self.tie_tolerance = tol;
+        self
+    }
+
+    /// A column whose part orthogonal to the active columns has squared norm at most
+    /// `tol * ||x_j||^2` is collinear and excluded for good. Default `1e-12` (the angle to
+    /// the active span below about 1e-6 rad), in `[0, 1e-2]`.
+    pub fn collinearity_tolerance(mut self, tol: f64) -> Self {
+        self.collinearity_tolerance = tol;
+        self
+    }
+
+    /// The path stops when the largest residual correlation falls to `tol` times its
+    /// starting value. Default `1e-12`, in `[0, 1e-3]`.
+    pub fn vanish_tolerance(mut self, tol: f64) -> Self {
+        self.vanish_tolerance = tol;
+        self
+    }
+
+    /// Gram matrix policy (speed only; the path is the same up to rounding).
+    pub fn gram(mut self, gram: Gram) -> Self {
+        self.gram = gram;
+        self
+    }
+
+    fn validate(&self) -> Result<()> {
+        if !(self.alpha_min.is_finite() && self.alpha_min >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "alpha_min",
+                reason: format!("must be finite and non-negative, got {}", self.alpha_min),
+            });
+        }
+        let checks: [(&'static str, f64, f64); 3] = [
+            ("tie_tolerance", self.tie_tolerance, 1e-3),
+            ("collinearity_tolerance", self.collinearity_tolerance, 1e-2),
+            ("vanish_tolerance", self.vanish_tolerance, 1e-3),
+        ];
+        for (name, v, max) in checks {
+            if !(v.is_finite() && (0.0..=max).contains(&v)) {
+                return Err(Error::InvalidParameter {
+                    name,
+                    reason: format!("must lie in [0, {max}], got {v}"),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Computes the path for design `x` (n x p, one row per sample) and target `y` (length n).
+    ///
+    /// Errors: [`Error::Empty`] for no rows or no columns, [`Error::DimensionMismatch`] if
+    /// `y.len() != n`, [`Error::NonFinite`] for NaN or infinite input,
+    /// [`Error::AllColumnsConstant`] when no column can enter, [`Error::InvalidParameter`]
+    /// for a bad setting.
+    pub fn fit(&self, x: &DMatrix<f64>, y: &[f64]) -> Result<Lars> {
+        self.validate()?;
+        let (n, p) = x.shape();
+        if n == 0 {
+            return Err(Error::Empty {
+                what: "design rows",
+            });
+        }
+        if p == 0 {
+            return Err(Error::Empty {
+                what: "design columns",
+            });
+        }
+        if y.len() != n {
+            return Err(Error::DimensionMismatch {
+                what: "target length vs design rows",
+                expected: n,
+                got: y.len(),
+            });
+        }
+        for j in 0..p {
+            if let Some(row) = x.column(j).iter().position(|v| !v.is_finite()) {
+                return Err(Error::NonFinite {
+                    what: "design",
+                    row,
+                    col: j,
+                });
+            }
+        }
+        if let Some(row) = y.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "target",
+                row,
+                col: 0,
+            });
+        }
+
+        // --- standardise ------------------------------------------------------------------
+        let nf = n as f64;
+        let mut x_mean = vec![0.0; p];
+        let mut x_scale = vec![1.0; p];
+        let mut xs = x.clone();
+        let mut excluded = Vec::new();
+        for j in 0..p {
+            let raw_norm = x.column(j).norm();
+            if self.fit_intercept {
+                x_mean[j] = x.column(j).sum() / nf;
+                let m = x_mean[j];
+                xs.column_mut(j).iter_mut().for_each(|v| *v -= m);
+            }
+            let norm = xs.column(j).norm();
+            // a constant column leaves only rounding (~ n eps |x|) after centring
+            if raw_norm == 0.0 || norm <= 1e-10 * raw_norm || !norm.is_finite() {
+                xs.column_mut(j).fill(0.0);
+                x_scale[j] = 1.0;
+                excluded.push(Exclusion {
+                    feature: j,
+                    reason: ExclusionReason::ZeroVariance,
+                    step: 0,
+                });
+                continue;
+            }
+            if self.normalize {
+                x_scale[j] = norm;
+                xs.column_mut(j).iter_mut().for_each(|v| *v /= norm);
+            }
+        }
+        if excluded.len() == p {
+            return Err(Error::AllColumnsConstant { columns: p });
+        }
+        let y_mean = if self.fit_intercept {
+            y.iter().sum::<f64>() / nf
+        } else {
+            0.0
+        };
+        let ys: Vec<f64> = y.iter().map(|v| v - y_mean).collect();
+
+        let use_gram = match self.gram {
+            Gram::Auto => p <= n && p <= 4096,
+            Gram::Precompute => true,
+            Gram::Never => false,
+        };
+        let mut eligible = vec![true; p];
+        for e in &excluded {
+            eligible[e.feature] = false;
+        }
+        let core = Core::new(&xs, use_gram);
+        let path = core.run(self, &ys, eligible, &mut excluded);
+        excluded.sort_by_key(|e| e.feature);
+
+        // --- back to the original scale ---------------------------------------------------
+        let knots = path.alphas.len();
+        let std_path = DMatrix::from_fn(knots, p, |k, j| path.coefs[k][j]);
+        let coef_path = DMatrix::from_fn(knots, p, |k, j| path.coefs[k][j] / x_scale[j]);
+        let intercepts = (0..knots)
+            .map(|k| y_mean - (0..p).map(|j| coef_path[(k, j)] * x_mean[j]).sum::<f64>())
+            .collect();
+        Ok(Lars {
+            params: self.clone(),
+            n_features: p,
+            alphas: path.alphas,
+            std_path,
+            coef_path,
+            intercepts,
+            events: path.events,
+            active: path.active,
+            excluded,
+            stop: path.stop,
+            x_mean,
+            x_scale,
+            y_mean,
+        })
+    }
+}
+
+/// A fitted LARS path: every knot, the events that changed the active set, and the final
+/// model on the original scale.
+///
+/// Knot `k` (0-based) holds `alphas()[k]` and row `k` of [`Lars::coef_path`]; knot 0 is the
+/// all-zero model (the intercept alone) at the largest alpha. Between knots the coefficients
+/// are linear in alpha.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Lars {
+    params: LarsParams,
+    n_features: usize,
+    alphas: Vec<f64>,
+    std_path: DMatrix<f64>,
+    coef_path: DMatrix<f64>,
+    intercepts: Vec<f64>,
+    events: Vec<PathEvent>,
+    active: Vec<usize>,
+    excluded: Vec<Exclusion>,
+    stop: StopReason,
+    x_mean: Vec<f64>,
+    x_scale: Vec<f64>,
+    y_mean: f64,
+}
+
+impl Lars {
+    /// A builder with the defaults of [`LarsParams`].
+    pub fn params() -> LarsParams {
+        LarsParams::default()
+    }
+
+    /// The parameters the path was computed with.
+    pub fn parameters(&self) -> &LarsParams {
+        &self.params
+    }
+
+    /// Number of columns of the design.
+    pub fn n_features(&self) -> usize {
+        self.n_features
+    }
+
+    /// Number of knots (at least 1).
+    pub fn n_knots(&self) -> usize {
+        self.alphas.len()
+    }
+
+    /// Alpha at every knot, non-increasing: `max_j |x_j^T r| / n` in the standardised
+    /// problem (scikit-learn's convention), `r` the residual at that knot.
+    pub fn alphas(&self) -> &[f64] {
+        &self.alphas
+    }
+
+    /// Coefficients at every knot on the original scale: row `k` is knot `k`, `knots x p`.
+    pub fn coef_path(&self) -> &DMatrix<f64> {
+        &self.coef_path
+    }
+
+    /// Coefficients at every knot in the standardised problem (centred and/or unit-norm
+    /// columns), the coordinates in which LAR moves; `knots x p`.
+    pub fn standardized_coef_path(&self) -> &DMatrix<f64> {
+        &self.std_path
+    }
+
+    /// The intercept at every knot (all zero without `fit_intercept`).
+    pub fn intercepts(&self) -> &[f64] {
+        &self.intercepts
+    }
+
+    /// Final coefficients (last knot), original scale.
+    pub fn coef(&self) -> DVector<f64> {
+        let last = self.alphas.len() - 1;
+        self.coef_path.row(last).transpose()
+    }
+
+    /// Final intercept (last knot).
+    pub fn intercept(&self) -> f64 {
+        self.intercepts[self.intercepts.len() - 1]
+    }
+
+    /// Changes of the active set in order: additions and (lasso) drops.
+    pub fn events(&self) -> &[PathEvent] {
+        &self.events
+    }
+
+    /// The active set at the end of the path, in order of entry (scikit-learn's `active`).
+    pub fn active(&self) -> &[usize] {
+        &self.active
+    }
+
+    /// Columns kept out of the path (zero variance or collinear), sorted by column.
+    pub fn excluded(&self) -> &[Exclusion] {
+        &self.excluded
+    }
+
+    /// Why the path ended.
+    pub fn stop_reason(&self) -> StopReason {
+        self.stop
+    }
+
+    /// Column means subtracted before the path (zeros without an intercept).
+    pub fn x_mean(&self) -> &[f64] {
+        &self.x_mean
+    }
+
+    /// Column scales divided out before the path (ones without normalisation).
+    pub fn x_scale(&self) -> &[f64] {
+        &self.x_scale
+    }
+
+    /// Target mean subtracted before the path (zero without an intercept).
+    pub fn y_mean(&self) -> f64 {
+        self.y_mean
+    }
+
+    /// Prediction of the final model for one sample `row` (length p), original scale.
+    pub fn predict_row(&self, row: &[f64]) -> Result<f64> {
+        self.predict_row_at(self.alphas.len() - 1, row)
+    }
+
+    /// Prediction of the model at knot `knot` for one sample.
+    pub fn predict_row_at(&self, knot: usize, row: &[f64]) -> Result<f64> {
+        if knot >= self.alphas.len() {
+            return Err(Error::InvalidParameter {
+                name: "knot",
+                reason: format!("path has {} knots, got {knot}", self.alphas.len()),
+            });
+        }
+        if row.len() != self.n_features {
+            return Err(Error::DimensionMismatch {
+                what: "sample length vs features",
+                expected: self.n_features,
+                got: row.len(),
+            });
+        }
+        if let Some(i) = row.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "sample",
+                row: i,
+                col: 0,
+            });
+        }
+        let b = self.coef_path.row(knot);
+        Ok(self.intercepts[knot] + b.iter().zip(row).map(|(b, x)| b * x).sum::<f64>())
+    }
+
+    /// Predictions of the final model for every row of `x` (n x p), original scale.
+    pub fn predict(&self, x: &DMatrix<f64>) -> Result<DVector<f64>> {
+        if x.ncols() != self.n_features {
+            return Err(Error::DimensionMismatch {
+                what: "design columns vs features",
+                expected: self.n_features,
+                got: x.ncols(),
+            });
+        }
+        for j in 0..x.ncols() {
+            if let Some(row) = x.column(j).iter().position(|v| !v.is_finite()) {
+                return Err(Error::NonFinite {
+                    what: "design",
+                    row,
+                    col: j,
+                });
+            }
+        }
+        let mut out = x * self.coef();
+        out.add_scalar_mut(self.intercept());
+        Ok(out)
+    }
+}
+
+// ------------------------------------------------------------------------------------------
+// The path itself, on the standardised problem.
+
+struct Path {
+    alphas: Vec<f64>,
+    coefs: Vec<Vec<f64>>,
+    events: Vec<PathEvent>,
+    active: Vec<usize>,
+    stop: StopReason,
+}
+
+struct Core<'a> {
+    xs: &'a DMatrix<f64>,
+    n: usize,
+    p: usize,
+    /// `X^T X`, when precomputed.
+    gram: Option<DMatrix<f64>>,
+    /// `||x_j||^2`.
+    sq_norms: Vec<f64>,
+}
+
+impl<'a> Core<'a> {
+    fn new(xs: &'a DMatrix<f64>, use_gram: bool) -> Self {
+        let (n, p) = xs.shape();
+        let gram = use_gram.then(|| xs.tr_mul(xs));
+        let sq_norms = match &gram {
+            Some(g) => (0..p).map(|j| g[(j, j)]).collect(),
+            None => (0..p).map(|j| xs.column(j).norm_squared()).collect(),
+        };
+        Core {
+            xs,
+            n,
+            p,
+            gram,
+            sq_norms,
+        }
+    }
+
+    fn col(&self, j: usize) -> &[f64] {
+        &self.xs.as_slice()[j * self.n..(j + 1) * self.n]
+    }
+
+    /// `G[A, j]` in the order of `active`.
+    fn gram_with_active(&self, active: &[usize], j: usize, out: &mut Vec<f64>) {
+        out.clear();
+        match &self.gram {
+            Some(g) => out.extend(active.iter().map(|&a| g[(a, j)])),
+            None => {
+                let xj = self.col(j);
+                out.extend(active.iter().map(|&a| dot(self.col(a), xj)));
+            }
+        }
+    }
+
+    /// `a = X^T X_A w` for every column.
+    fn equiangular_correlations(&self, active: &[usize], w: &[f64], a: &mut [f64]) {
+        a.iter_mut().for_each(|v| *v = 0.0);
+        match &self.gram {
+            Some(g) => {
+                for (&k, &wk) in active.iter().zip(w) {
+                    let gk = &g.as_slice()[k * self.p..(k + 1) * self.p];
+                    for (ai, gi) in a.iter_mut().zip(gk) {
+                        *ai += wk * gi;
+                    }
+                }
+            }
+            None => {
+                let mut u = vec![0.0; self.n];
+                for (&k, &wk) in active.iter().zip(w) {
+                    for (ui, xi) in u.iter_mut().zip(self.col(k)) {
+                        *ui += wk * xi;
+                    }
+                }
+                for (j, aj) in a.iter_mut().enumerate() {
+                    *aj = dot(self.col(j), &u);
+                }
+            }
+        }
+    }
+
+    fn run(
+        &self,
+        params: &LarsParams,
+        ys: &[f64],
+        mut eligible: Vec<bool>,
+        excluded: &mut Vec<Exclusion>,
+    ) -> Path {
+        let p = self.p;
+        let nf = self.n as f64;
+        let mut c: Vec<f64> = (0..p)
+            .map(|j| {
+                if eligible[j] {
+                    dot(self.col(j), ys)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let c0 = (0..p)
+            .filter(|&j| eligible[j])
+            .map(|j| c[j].abs())
+            .fold(0.0, f64::max);
+
+        let mut beta = vec![0.0; p];
+        let mut alphas = vec![c0 / nf];
+        let mut coefs = vec![beta.clone()];
+        let mut events = Vec::new();
+        let mut active: Vec<usize> = Vec::new();
+        let mut signs: Vec<f64> = Vec::new();
+        let mut is_active = vec![false; p];
+        let mut chol = CholeskyFactor::default();
+        let mut just_dropped: Vec<usize> = Vec::new();
+        let mut big_c = c0;
+        let mut step = 0usize;
+        let mut scratch = Vec::new();
+        let mut a = vec![0.0; p];
+
+        let finish = |alphas, coefs, events, active, stop| Path {
+            alphas,
+            coefs,
+            events,
+            active,
+            stop,
+        };
+
+        if c0.is_nan() || c0 <= 0.0 {
+            alphas[0] = 0.0;
+            return finish(
+                alphas,
+                coefs,
+                events,
+                active,
+                StopReason::CorrelationVanished,
+            );
+        }
+        if c0 / nf <= params.alpha_min {
+            alphas[0] = params.alpha_min;
+            return finish(alphas, coefs, events, active, StopReason::AlphaMin);
+        }
+
+        loop {
+            if big_c <= params.vanish_tolerance * c0 {
+                return finish(
+                    alphas,
+                    coefs,
+                    events,
+                    active,
+                    StopReason::CorrelationVanished,
+                );
+            }
+            if params.max_steps.is_some_and(|m| step >= m) {
+                return finish(alphas, coefs, events, active, StopReason::MaxSteps);
+            }
+            step += 1;
+
+            // --- variables that tie for the largest correlation enter -------------------------
+            let threshold = big_c * (1.0 - params.tie_tolerance);
+            let mut candidates: Vec<usize> = (0..p)
+                .filter(|&j| {
+                    eligible[j]
+                        && !is_active[j]
+                        && !just_dropped.contains(&j)
+                        && c[j].abs() >= threshold
+                })
+                .collect();
+            candidates.sort_by(|&i, &j| c[j].abs().total_cmp(&c[i].abs()).then(i.cmp(&j)));
+            for j in candidates {
+                self.gram_with_active(&active, j, &mut scratch);
+                match chol.append(&scratch, self.sq_norms[j], params.collinearity_tolerance) {
+                    Append::Appended => {
+                        active.push(j);
+                        signs.push(if c[j] >= 0.0 { 1.0 } else { -1.0 });
+                        is_active[j] = true;
+                        events.push(PathEvent::Added { feature: j, step });
+                    }
+                    Append::Collinear => {
+                        eligible[j] = false;
+                        excluded.push(Exclusion {
+                            feature: j,
+                            reason: ExclusionReason::Collinear,
+                            step,
+                        });
+                        log::debug!("LARS step {step}: column {j} is collinear, excluded");
+                    }
+                }
+            }
+            if active.is_empty() {
+                return finish(
+                    alphas,
+                    coefs,
+                    events,
+                    active,
+                    StopReason::CorrelationVanished,
+                );
+            }
+
+            // --- equiangular direction: w = AA G_AA^{-1} s ---------------------------------
+            let mut w = signs.clone();
+            chol.solve_in_place(&mut w);
+            let q: f64 = w.iter().zip(&signs).map(|(wi, si)| wi * si).sum();
+            if !(q.is_finite() && q > 0.0) {
+                return finish(
+                    alphas,
+                    coefs,
+                    events,
+                    active,
+                    StopReason::NumericalBreakdown,
+                );
+            }
+            let aa = 1.0 / q.sqrt();
+            w.iter_mut().for_each(|v| *v *= aa);
+            self.equiangular_correlations(&active, &w, &mut a);
+
+            // --- step length --------------------------------------------------------------
+            let gamma_hat = big_c / aa;
+            let mut gamma = gamma_hat;
+            let mut any_inactive = false;
+            for j in 0..p {
+                if !eligible[j] || is_active[j] {
+                    continue;
+                }
+                any_inactive = true;
+                let dropped_now = just_dropped.contains(&j);
+                for side in [1.0, -1.0] {
+                    // a just-dropped variable sits exactly at |c_j| = C on its own side
+                    if dropped_now && side * c[j] > 0.0 {
+                        continue;
+                    }
+                    let num = big_c - side * c[j];
+                    let den = aa - side * a[j];
+                    if num > 0.0 && den > 0.0 {
+                        let g = num / den;
+                        if g < gamma {
+                            gamma = g;
+                        }
+                    }
+                }
+            }
+            // lasso: the first active coefficient to reach zero
+            let mut drops: Vec<usize> = Vec::new(); // positions in `active`
+            if params.method == Method::Lasso {
+                let mut z_min = f64::INFINITY;
+                for (pos, &j) in active.iter().enumerate() {
+                    if w[pos] != 0.0 {
+                        let z = -beta[j] / w[pos];
+                        if z > 0.0 && z < z_min {
+                            z_min = z;
+                        }
+                    }
+                }
+                if z_min < gamma {
+                    gamma = z_min;
+                    for (pos, &j) in active.iter().enumerate() {
+                        if w[pos] != 0.0 {
+                            let z = -beta[j] / w[pos];
+                            if z > 0.0 && z <= z_min * (1.0 + 1e-12) {
+                                drops.push(pos);
+                            }
+                        }
+                    }
+                }
+            }
+            let full_step = drops.is_empty() && gamma >= gamma_hat;
+
+            // --- move -------------------------------------------------------------------
+            for (pos, &j) in active.iter().enumerate() {
+                beta[j] += gamma * w[pos];
+            }
+            for (cj, aj) in c.iter_mut().zip(&a) {
+                *cj -= gamma * aj;
+            }
+            big_c = if full_step {
+                0.0
+            } else {
+                (big_c - gamma * aa).max(0.0)
+            };
+
+            just_dropped.clear();
+            for &pos in drops.iter().rev() {
+                let j = active.remove(pos);
+                signs.remove(pos);
+                chol.remove(pos);
+                is_active[j] = false;
+                beta[j] = 0.0;
+                just_dropped.push(j);
+                events.push(PathEvent::Dropped { feature: j, step });
+            }
+
+            let alpha = big_c / nf;
+            let prev_alpha = alphas[alphas.len() - 1];
+            if params.alpha_min > 0.0 && alpha <= params.alpha_min {
+                let prev = &coefs[coefs.len() - 1];
+                let ss = if prev_alpha > alpha {
+                    (prev_alpha - params.alpha_min) / (prev_alpha - alpha)
+                } else {
+                    1.0
+                };
+                let knot: Vec<f64> = prev
+                    .iter()
+                    .zip(&beta)
+                    .map(|(b0, b1)| b0 + ss * (b1 - b0))
+                    .collect();
+                alphas.push(params.alpha_min);
+                coefs.push(knot);
+                return finish(alphas, coefs, events, active, StopReason::AlphaMin);
+            }
+            alphas.push(alpha);
+            coefs.push(beta.clone());
+            if full_step {
+                let stop = if any_inactive {
+                    StopReason::CorrelationVanished
+                } else {
+                    StopReason::Complete
+                };
+                return finish(alphas, coefs, events, active, stop);
+            }
+        }
+    }
+}

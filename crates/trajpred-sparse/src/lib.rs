@@ -1,0 +1,11 @@
+//! # trajpred-sparse
+//!
+//! Least angle regression and group sparse coding.
+#![forbid(unsafe_code)]
+
+mod cholesky;
+pub mod error;
+pub mod lars;
+
+pub use error::{Error, Result};
+pub use lars::{Exclusion, ExclusionReason, Gram, Lars, LarsParams, Method, PathEvent, StopReason};
