@@ -1,0 +1,195 @@
+//! Bad and degenerate input: every error variant of the LARS builder is reached, and the
+//! degenerate-but-valid cases (constant target, some constant columns, ties) give a
+//! documented path instead of NaN or a panic.
+
+use nalgebra::DMatrix;
+use trajpred_sparse::{Error, ExclusionReason, Lars, Method, PathEvent, StopReason};
+
+fn small() -> (DMatrix<f64>, Vec<f64>) {
+    let x = DMatrix::from_row_slice(
+        5,
+        3,
+        &[
+            1.0, 2.0, 0.5, 2.0, 1.0, 1.5, 3.0, 5.0, 2.5, 4.0, 2.0, 0.0, 5.0, 4.0, 1.0,
+        ],
+    );
+    (x, vec![1.0, 2.0, 4.0, 3.0, 6.0])
+}
+
+#[test]
+fn nan_and_infinity_are_located() {
+    let (mut x, y) = small();
+    x[(3, 1)] = f64::NAN;
+    assert_eq!(
+        Lars::params().fit(&x, &y).unwrap_err(),
+        Error::NonFinite {
+            what: "design",
+            row: 3,
+            col: 1
+        }
+    );
+    let (x, mut y) = small();
+    y[2] = f64::INFINITY;
+    assert_eq!(
+        Lars::params().fit(&x, &y).unwrap_err(),
+        Error::NonFinite {
+            what: "target",
+            row: 2,
+            col: 0
+        }
+    );
+}
+
+#[test]
+fn mismatched_and_empty_inputs() {
+    let (x, y) = small();
+    assert!(matches!(
+        Lars::params().fit(&x, &y[..4]),
+        Err(Error::DimensionMismatch {
+            expected: 5,
+            got: 4,
+            ..
+        })
+    ));
+    assert!(matches!(
+        Lars::params().fit(&DMatrix::zeros(0, 3), &[]),
+        Err(Error::Empty { .. })
+    ));
+    assert!(matches!(
+        Lars::params().fit(&DMatrix::zeros(5, 0), &y),
+        Err(Error::Empty { .. })
+    ));
+    let fit = Lars::params().fit(&x, &y).expect("fit");
+    assert!(matches!(
+        fit.predict_row(&[1.0, 2.0]),
+        Err(Error::DimensionMismatch {
+            expected: 3,
+            got: 2,
+            ..
+        })
+    ));
+    assert!(matches!(
+        fit.predict(&DMatrix::zeros(2, 4)),
+        Err(Error::DimensionMismatch {
+            expected: 3,
+            got: 4,
+            ..
+        })
+    ));
+    assert!(matches!(
+        fit.predict_row(&[1.0, f64::NAN, 0.0]),
+        Err(Error::NonFinite { .. })
+    ));
+    assert!(matches!(
+        fit.predict_row_at(99, &[1.0, 2.0, 0.0]),
+        Err(Error::InvalidParameter { name: "knot", .. })
+    ));
+}
+
+#[test]
+fn all_constant_columns_are_an_error() {
+    let x = DMatrix::from_fn(6, 3, |_, j| j as f64 + 1.0);
+    let y = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+    assert_eq!(
+        Lars::params().fit(&x, &y).unwrap_err(),
+        Error::AllColumnsConstant { columns: 3 }
+    );
+    // without an intercept a constant column is a legitimate regressor; a zero column is not
+    assert!(Lars::params().fit_intercept(false).fit(&x, &y).is_ok());
+    assert_eq!(
+        Lars::params()
+            .fit_intercept(false)
+            .fit(&DMatrix::zeros(6, 2), &y)
+            .unwrap_err(),
+        Error::AllColumnsConstant { columns: 2 }
+    );
+    // one row with an intercept: every centred column is zero
+    assert!(matches!(
+        Lars::params().fit(&DMatrix::from_row_slice(1, 2, &[1.0, 2.0]), &[3.0]),
+        Err(Error::AllColumnsConstant { .. })
+    ));
+}
+
+#[test]
+fn invalid_parameters() {
+    let (x, y) = small();
+    for params in [
+        Lars::params().alpha_min(f64::NAN),
+        Lars::params().alpha_min(-0.1),
+        Lars::params().tie_tolerance(0.5),
+        Lars::params().collinearity_tolerance(-1.0),
+        Lars::params().vanish_tolerance(f64::INFINITY),
+    ] {
+        assert!(matches!(
+            params.fit(&x, &y),
+            Err(Error::InvalidParameter { .. })
+        ));
+    }
+}
+
+#[test]
+fn constant_column_is_excluded_and_reported() {
+    let (x, y) = small();
+    let mut x4 = x.clone().insert_column(1, 7.0);
+    x4[(0, 1)] = 7.0;
+    let fit = Lars::params().fit(&x4, &y).expect("fit");
+    assert_eq!(fit.excluded().len(), 1);
+    assert_eq!(fit.excluded()[0].feature, 1);
+    assert_eq!(fit.excluded()[0].reason, ExclusionReason::ZeroVariance);
+    assert!(fit.coef_path().column(1).iter().all(|&v| v == 0.0));
+    // the other columns give the same path as without the constant column
+    let reference = Lars::params().fit(&x, &y).expect("fit");
+    let a = fit.coef_path().clone().remove_column(1);
+    assert!((a - reference.coef_path()).amax() < 1e-12 * reference.coef_path().amax());
+}
+
+#[test]
+fn constant_target_gives_the_single_zero_knot() {
+    let (x, _) = small();
+    let fit = Lars::params().fit(&x, &[2.5; 5]).expect("fit");
+    assert_eq!(fit.n_knots(), 1);
+    assert_eq!(fit.alphas(), &[0.0]);
+    assert_eq!(fit.stop_reason(), StopReason::CorrelationVanished);
+    assert_eq!(fit.predict_row(&[9.0, 9.0, 9.0]).expect("predict"), 2.5);
+}
+
+#[test]
+fn exact_ties_enter_together() {
+    // columns 0 and 1 are different but have exactly the same correlation with y
+    let x = DMatrix::from_row_slice(
+        4,
+        3,
+        &[
+            1.0, 1.0, 0.0, 1.0, -1.0, 1.0, -1.0, 1.0, 0.0, -1.0, -1.0, -1.0,
+        ],
+    );
+    let y = [2.0, 0.0, 0.0, -2.0];
+    let fit = Lars::params()
+        .fit_intercept(false)
+        .normalize(false)
+        .method(Method::Lar)
+        .fit(&x, &y)
+        .expect("fit");
+    let first: Vec<usize> = fit
+        .events()
+        .iter()
+        .filter_map(|e| match e {
+            PathEvent::Added { feature, step: 1 } => Some(*feature),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(first, vec![0, 1]);
+    assert!(fit.coef_path().iter().all(|v| v.is_finite()));
+}
+
+#[test]
+fn max_steps_zero_and_alpha_min_above_the_start() {
+    let (x, y) = small();
+    let fit = Lars::params().max_steps(0).fit(&x, &y).expect("fit");
+    assert_eq!(fit.n_knots(), 1);
+    assert_eq!(fit.stop_reason(), StopReason::MaxSteps);
+    let fit = Lars::params().alpha_min(1e6).fit(&x, &y).expect("fit");
+    assert_eq!(fit.alphas(), &[1e6]);
+    assert_eq!(fit.stop_reason(), StopReason::AlphaMin);
+    assert!(fit.coef().iter().all(|&v| v == 0.0));
+}
