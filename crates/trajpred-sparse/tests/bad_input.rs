@@ -2,6 +2,8 @@
 //! degenerate-but-valid cases (constant target, some constant columns, ties) give a
 //! documented path instead of NaN or a panic.
 
+#![allow(clippy::needless_range_loop)] // index loops mirror the knot/feature indices of the formulas
+
 use nalgebra::DMatrix;
 use trajpred_sparse::{Error, ExclusionReason, Lars, Method, PathEvent, StopReason};
 

@@ -6,6 +6,8 @@
 //! stable arithmetic; on these inputs the paths agree to ~1e-12, so 1e-9 leaves margin for
 //! rounding and still catches any algorithmic difference (those are O(1)).
 
+#![allow(clippy::needless_range_loop)] // index loops mirror the knot/feature indices of the formulas
+
 use nalgebra::DMatrix;
 use serde_json::Value;
 use trajpred_sparse::{ExclusionReason, Gram, Lars, LarsParams, Method, PathEvent, StopReason};

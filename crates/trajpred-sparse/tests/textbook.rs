@@ -8,6 +8,8 @@
 //! Tolerance 1e-9 relative to `C`: the correlations are recomputed here from scratch as
 //! `X^T (y - X beta)` in O(n p) flops of O(1)-sized terms, rounding ~1e-14 relative.
 
+#![allow(clippy::needless_range_loop)] // index loops mirror the knot/feature indices of the formulas
+
 use nalgebra::{DMatrix, DVector};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
