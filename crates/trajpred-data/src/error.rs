@@ -53,7 +53,6 @@ pub enum Error {
 /// `Result` with [`enum@Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
-#[allow(dead_code)] // used by the loaders
 impl Error {
     pub(crate) fn io(file: impl std::fmt::Display, source: std::io::Error) -> Self {
         Error::Io {

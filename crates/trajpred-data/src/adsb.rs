@@ -1,0 +1,227 @@
+//! ADS-B flights as the `traffic` Python package ships them: gzip-compressed (or plain) JSON,
+//! either a list of records (`[{"timestamp": ..., "icao24": ..., ...}, ...]`) or pandas'
+//! column-wise layout (`{"timestamp": {"0": ..., "1": ...}, "latitude": {...}, ...}`).
+//!
+//! Units: `timestamp` in milliseconds since the Unix epoch (UTC), `latitude`/`longitude` in
+//! degrees, `altitude` (barometric) in feet, converted to metres and used as the height of
+//! the 3-D point (see `docs/data.md`). Records are grouped into flights by
+//! (`icao24`, `callsign`) within a file (and by `flight_id` too where records carry one), sorted by time (ties keep file order), cleaned with
+//! the shared time rule and split at gaps longer than [`LoadOptions::max_gap`]. A record with
+//! a null timestamp, latitude or longitude (or a null altitude when 3-D points are asked for)
+//! is skipped as [`SkipReason::MissingValue`]. Line numbers
+//! in the report are 1-based record indices.
+//!
+//! ```
+//! use trajpred_data::{adsb, LoadOptions, SkipReason};
+//! let f = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/adsb/columns.json.gz");
+//! let (tracks, report) = adsb::load_file(f.as_ref(), &LoadOptions::adsb())?;
+//! assert_eq!(tracks.len(), 1);
+//! assert_eq!(report.skipped(SkipReason::MissingValue), 1);
+//! # Ok::<(), trajpred_data::Error>(())
+//! ```
+
+use crate::error::{Error, Result};
+use crate::geodesy::FOOT;
+use crate::io::{list, read_all};
+use crate::report::{LoadReport, SkipReason};
+use crate::track::{Cleaner, FrameKind, LoadOptions, RawPoint, Track};
+use serde::Deserialize;
+use serde_json::Value;
+use serde_json::value::RawValue;
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+
+/// (icao24, callsign, flight_id)
+type FlightKey = (Option<String>, Option<String>, Option<String>);
+
+#[derive(Debug, Default, Deserialize)]
+struct Record {
+    timestamp: Option<f64>,
+    icao24: Option<String>,
+    callsign: Option<String>,
+    latitude: Option<f64>,
+    longitude: Option<f64>,
+    altitude: Option<f64>,
+    flight_id: Option<Value>,
+}
+
+/// Parses one JSON document (already decompressed) named `file`, adding to `report`.
+/// A document that is not JSON, or neither an array nor an object, is an
+/// [`Error::Parse`]; a record of the wrong shape is skipped as malformed.
+pub fn parse_json(
+    json: &[u8],
+    file: &str,
+    opts: &LoadOptions,
+    report: &mut LoadReport,
+) -> Result<Vec<Track>> {
+    opts.validate()?;
+    report.files_read += 1;
+    let mut c = Cleaner { opts, file, report };
+    let json_err = |e: serde_json::Error| Error::parse(file, e.line(), format!("JSON: {e}"));
+    let first = json.iter().find(|b| !b.is_ascii_whitespace());
+    let mut records: Vec<(usize, Record)> = Vec::new();
+    match first {
+        Some(b'[') => {
+            let raws: Vec<&RawValue> = serde_json::from_slice(json).map_err(json_err)?;
+            records.reserve(raws.len());
+            for (i, raw) in raws.into_iter().enumerate() {
+                c.report.records_read += 1;
+                match serde_json::from_str::<Record>(raw.get()) {
+                    Ok(r) => records.push((i + 1, r)),
+                    Err(e) => c.malformed(i + 1, format!("record: {e}"))?,
+                }
+            }
+        }
+        Some(b'{') => {
+            let cols: HashMap<String, BTreeMap<String, Value>> =
+                serde_json::from_slice(json).map_err(json_err)?;
+            let mut rows: BTreeMap<usize, Record> = BTreeMap::new();
+            let mut bad: BTreeMap<usize, String> = BTreeMap::new();
+            for (name, col) in &cols {
+                for (key, v) in col {
+                    let Ok(row) = key.parse::<usize>() else {
+                        return Err(Error::parse(
+                            file,
+                            1,
+                            format!("column {name:?}: row key {key:?} is not an index"),
+                        ));
+                    };
+                    let r = rows.entry(row).or_default();
+                    let num = |v: &Value| match v {
+                        Value::Null => Ok(None),
+                        Value::Number(n) => Ok(n.as_f64()),
+                        other => Err(format!("{name}: expected a number, got {other}")),
+                    };
+                    let text = |v: &Value| match v {
+                        Value::Null => Ok(None),
+                        Value::String(s) => Ok(Some(s.clone())),
+                        other => Err(format!("{name}: expected a string, got {other}")),
+                    };
+                    let res = match name.as_str() {
+                        "timestamp" => num(v).map(|x| r.timestamp = x),
+                        "latitude" => num(v).map(|x| r.latitude = x),
+                        "longitude" => num(v).map(|x| r.longitude = x),
+                        "altitude" => num(v).map(|x| r.altitude = x),
+                        "icao24" => text(v).map(|x| r.icao24 = x),
+                        "callsign" => text(v).map(|x| r.callsign = x),
+                        "flight_id" => {
+                            r.flight_id = Some(v.clone());
+                            Ok(())
+                        }
+                        _ => Ok(()),
+                    };
+                    if let Err(e) = res {
+                        bad.entry(row).or_insert(e);
+                    }
+                }
+            }
+            for (row, r) in rows {
+                c.report.records_read += 1;
+                match bad.remove(&row) {
+                    Some(e) => c.malformed(row + 1, e)?,
+                    None => records.push((row + 1, r)),
+                }
+            }
+        }
+        _ => {
+            return Err(Error::parse(
+                file,
+                1,
+                "not a JSON array of records or object of columns",
+            ));
+        }
+    }
+    // group by (icao24, callsign, flight_id) in order of first appearance; every parsed
+    // record counts towards the groups, whether or not its position is usable
+    let mut order: Vec<FlightKey> = Vec::new();
+    let mut groups: HashMap<FlightKey, Vec<RawPoint>> = HashMap::new();
+    for (line, r) in records {
+        let flight = match r.flight_id {
+            None | Some(Value::Null) => None,
+            Some(Value::String(s)) => Some(s),
+            Some(v) => Some(v.to_string()),
+        };
+        let key = (r.icao24, r.callsign.map(|s| s.trim().to_string()), flight);
+        let group = groups.entry(key.clone()).or_insert_with(|| {
+            order.push(key);
+            Vec::new()
+        });
+        let (Some(ts), Some(lat), Some(lon)) = (r.timestamp, r.latitude, r.longitude) else {
+            c.report.skip(
+                file,
+                line,
+                SkipReason::MissingValue,
+                "timestamp/latitude/longitude",
+            );
+            continue;
+        };
+        let p = RawPoint {
+            line,
+            t: ts / 1000.0,
+            a: lat,
+            b: lon,
+            alt: r.altitude.map(|ft| ft * FOOT),
+        };
+        if c.accept_geodetic(&p)? {
+            group.push(p);
+        }
+    }
+    c.report.groups += order.len();
+    let mut out = Vec::new();
+    for key in order {
+        let Some(mut pts) = groups.remove(&key) else {
+            continue;
+        };
+        pts.sort_by(|a, b| a.t.total_cmp(&b.t).then(a.line.cmp(&b.line)));
+        let mut id = format!(
+            "{}/{}",
+            key.0.as_deref().unwrap_or("?"),
+            key.1.as_deref().unwrap_or("?")
+        );
+        if let Some(f) = &key.2 {
+            id = format!("{id}/{f}");
+        }
+        c.finish(&id, pts, FrameKind::Geodetic, &mut out)?;
+    }
+    Ok(out)
+}
+
+/// Loads one `.json` or `.json.gz` file (gzip detected by its magic bytes).
+pub fn load_file(path: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadReport)> {
+    let bytes = read_all(path)?;
+    let mut report = LoadReport::new();
+    let tracks = parse_json(&bytes, &path.display().to_string(), opts, &mut report)?;
+    Ok((tracks, report))
+}
+
+/// The `.json` and `.json.gz` files under `dir`, recursively, sorted by path.
+pub fn files(dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    for p in list(dir, |_| true)? {
+        if p.is_dir() {
+            out.extend(files(&p)?);
+        } else {
+            let name = p
+                .file_name()
+                .map(|s| s.to_string_lossy().to_lowercase())
+                .unwrap_or_default();
+            if name.ends_with(".json") || name.ends_with(".json.gz") {
+                out.push(p);
+            }
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// Loads every file of [`files`]`(dir)`.
+pub fn load_dir(dir: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadReport)> {
+    let mut tracks = Vec::new();
+    let mut report = LoadReport::new();
+    for f in files(dir)? {
+        let (t, r) = load_file(&f, opts)?;
+        tracks.extend(t);
+        report.merge(r);
+    }
+    Ok((tracks, report))
+}

@@ -1,0 +1,133 @@
+//! T-Drive (Microsoft Research) taxi logs: `taxi_id,YYYY-MM-DD HH:MM:SS,lon,lat`, one file
+//! per taxi, no header.
+//!
+//! Cleaning, in this order per line: an exact copy of the previous line is dropped
+//! ([`SkipReason::DuplicateLine`]); malformed lines and
+//! lines of another taxi are dropped; positions at (0, 0) and outside the bounding box
+//! ([`LoadOptions::tdrive`] uses [`BoundingBox::BEIJING`](crate::BoundingBox::BEIJING)) are
+//! dropped; then the shared time rule (first of equal timestamps kept) and the split at gaps
+//! longer than [`LoadOptions::max_gap`]. The times (most likely Beijing local time) are read
+//! as if UTC.
+//!
+//! ```
+//! use trajpred_data::{tdrive, LoadOptions, SkipReason};
+//! let f = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/tdrive/7.txt");
+//! let (tracks, report) = tdrive::load_file(f.as_ref(), &LoadOptions::tdrive())?;
+//! assert_eq!(report.skipped(SkipReason::DuplicateLine), 1);
+//! assert_eq!(report.skipped(SkipReason::ZeroPosition), 1);
+//! assert_eq!(tracks.len(), 2); // split at the 2-hour gap
+//! # Ok::<(), trajpred_data::Error>(())
+//! ```
+
+use crate::error::Result;
+use crate::io::{for_each_line, list, open, stem};
+use crate::report::{LoadReport, SkipReason};
+use crate::time::parse_datetime;
+use crate::track::{Cleaner, FrameKind, LoadOptions, RawPoint, Track, num};
+use std::io::BufRead;
+use std::path::{Path, PathBuf};
+
+/// Parses one taxi's log named `file`, adding to `report`. The track id is the taxi id of the
+/// first well-formed line (or `file`'s stem when there is none).
+pub fn parse<R: BufRead>(
+    reader: R,
+    file: &str,
+    opts: &LoadOptions,
+    report: &mut LoadReport,
+) -> Result<Vec<Track>> {
+    opts.validate()?;
+    report.files_read += 1;
+    report.groups += 1;
+    let mut points = Vec::new();
+    let mut taxi: Option<String> = None;
+    let mut previous: Option<String> = None;
+    let mut c = Cleaner { opts, file, report };
+    for_each_line(reader, file, |line, text| {
+        let Some(text) = text else {
+            c.report.records_read += 1;
+            previous = None;
+            return c.malformed(line, "invalid UTF-8");
+        };
+        if text.trim().is_empty() {
+            c.report.blank_lines += 1;
+            return Ok(());
+        }
+        c.report.records_read += 1;
+        if previous.as_deref() == Some(text) {
+            c.report.skip(file, line, SkipReason::DuplicateLine, "");
+            return Ok(());
+        }
+        previous = Some(text.to_string());
+        let f: Vec<&str> = text.split(',').collect();
+        if f.len() != 4 {
+            return c.malformed(line, format!("expected 4 fields, got {}", f.len()));
+        }
+        let id = f[0].trim();
+        if id.is_empty() {
+            return c.malformed(line, "empty taxi id");
+        }
+        let Some(t) = parse_datetime(f[1]) else {
+            return c.malformed(line, format!("bad date/time {:?}", f[1]));
+        };
+        let (Some(lon), Some(lat)) = (num(f[2]), num(f[3])) else {
+            return c.malformed(line, format!("bad lon/lat {:?} {:?}", f[2], f[3]));
+        };
+        match &taxi {
+            Some(first) if first != id => {
+                c.report.skip(
+                    file,
+                    line,
+                    SkipReason::ForeignId,
+                    format!("taxi {id}, expected {first}"),
+                );
+                return Ok(());
+            }
+            None => taxi = Some(id.to_string()),
+            _ => {}
+        }
+        let p = RawPoint {
+            line,
+            t,
+            a: lat,
+            b: lon,
+            alt: None,
+        };
+        if c.accept_geodetic(&p)? {
+            points.push(p);
+        }
+        Ok(())
+    })?;
+    let id = taxi.unwrap_or_else(|| stem(Path::new(file)));
+    let mut out = Vec::new();
+    c.finish(&id, points, FrameKind::Geodetic, &mut out)?;
+    Ok(out)
+}
+
+/// Loads one taxi file.
+pub fn load_file(path: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadReport)> {
+    let mut report = LoadReport::new();
+    let tracks = parse(open(path)?, &path.display().to_string(), opts, &mut report)?;
+    Ok((tracks, report))
+}
+
+/// The `.txt` files of a T-Drive folder, sorted by taxi id (numerically where the stem is a
+/// number).
+pub fn files(dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut v = list(dir, |p| {
+        p.is_file() && p.extension().is_some_and(|e| e.eq_ignore_ascii_case("txt"))
+    })?;
+    v.sort_by_key(|p| (stem(p).parse::<u64>().unwrap_or(u64::MAX), p.clone()));
+    Ok(v)
+}
+
+/// Loads every taxi file of a folder (see [`files`]).
+pub fn load_dir(dir: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadReport)> {
+    let mut tracks = Vec::new();
+    let mut report = LoadReport::new();
+    for f in files(dir)? {
+        let (t, r) = load_file(&f, opts)?;
+        tracks.extend(t);
+        report.merge(r);
+    }
+    Ok((tracks, report))
+}

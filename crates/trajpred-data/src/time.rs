@@ -1,0 +1,127 @@
+//! Calendar dates and times of the fixed text formats, to seconds since the Unix epoch,
+//! parsed by hand (no time-zone database: every format here is UTC or treated as such).
+
+/// Days from 1970-01-01 to the proleptic Gregorian date `y-m-d` (H. Hinnant's algorithm).
+pub fn days_from_civil(y: i64, m: u32, d: u32) -> i64 {
+    let y = if m <= 2 { y - 1 } else { y };
+    let era = y.div_euclid(400);
+    let yoe = y - era * 400;
+    let m = i64::from(m);
+    let doy = (153 * (if m > 2 { m - 3 } else { m + 9 }) + 2) / 5 + i64::from(d) - 1;
+    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+    era * 146_097 + doe - 719_468
+}
+
+fn is_leap(y: i64) -> bool {
+    (y % 4 == 0 && y % 100 != 0) || y % 400 == 0
+}
+
+fn days_in_month(y: i64, m: u32) -> u32 {
+    match m {
+        1 | 3 | 5 | 7 | 8 | 10 | 12 => 31,
+        4 | 6 | 9 | 11 => 30,
+        2 if is_leap(y) => 29,
+        _ => 28,
+    }
+}
+
+fn digits(s: &str) -> Option<u32> {
+    if s.is_empty() || s.len() > 4 || !s.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    s.parse().ok()
+}
+
+/// A date `YYYY<sep>MM<sep>DD` (sep `-` or `/`) to days since 1970-01-01, with the month and
+/// day checked against the calendar.
+pub fn parse_date(s: &str) -> Option<i64> {
+    let mut it = s.trim().split(['-', '/']);
+    let (y, m, d) = (it.next()?, it.next()?, it.next()?);
+    if it.next().is_some() || y.len() != 4 {
+        return None;
+    }
+    let (y, m, d) = (i64::from(digits(y)?), digits(m)?, digits(d)?);
+    if !(1..=12).contains(&m) || d == 0 || d > days_in_month(y, m) {
+        return None;
+    }
+    Some(days_from_civil(y, m, d))
+}
+
+/// A time of day `HH:MM:SS` (seconds may carry a fraction) to seconds since midnight.
+pub fn parse_time(s: &str) -> Option<f64> {
+    let mut it = s.trim().split(':');
+    let (h, m, sec) = (it.next()?, it.next()?, it.next()?);
+    if it.next().is_some() {
+        return None;
+    }
+    let (h, m) = (digits(h)?, digits(m)?);
+    let (whole, frac) = match sec.split_once('.') {
+        Some((w, f)) if !f.is_empty() && f.bytes().all(|b| b.is_ascii_digit()) => {
+            (w, format!("0.{f}").parse::<f64>().ok()?)
+        }
+        Some(_) => return None,
+        None => (sec, 0.0),
+    };
+    let s = digits(whole)?;
+    if h > 23 || m > 59 || s > 59 {
+        return None;
+    }
+    Some(f64::from(h * 3600 + m * 60 + s) + frac)
+}
+
+/// `date` and `time` (see [`parse_date`], [`parse_time`]) to seconds since the Unix epoch.
+pub fn parse_date_time(date: &str, time: &str) -> Option<f64> {
+    Some(parse_date(date)? as f64 * 86_400.0 + parse_time(time)?)
+}
+
+/// `YYYY-MM-DD HH:MM:SS` (one space, or a `T`) to seconds since the Unix epoch.
+pub fn parse_datetime(s: &str) -> Option<f64> {
+    let s = s.trim();
+    let (d, t) = s.split_once([' ', 'T'])?;
+    parse_date_time(d, t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn known_epochs() {
+        // `date -u -d '2008-10-23 02:53:04' +%s` = 1224730384
+        assert_eq!(
+            parse_date_time("2008-10-23", "02:53:04"),
+            Some(1_224_730_384.0)
+        );
+        // `date -u -d '2008-02-02 15:36:08' +%s` = 1201966568
+        assert_eq!(parse_datetime("2008-02-02 15:36:08"), Some(1_201_966_568.0));
+        assert_eq!(parse_datetime("1970-01-01 00:00:00"), Some(0.0));
+        assert_eq!(parse_date("2000-02-29"), Some(11_016));
+        assert_eq!(parse_date("2008/05/30"), parse_date("2008-05-30"));
+        assert_eq!(parse_time("00:00:01.5"), Some(1.5));
+    }
+
+    #[test]
+    fn rejects_impossible_dates() {
+        for s in [
+            "2001-02-29",
+            "2008-13-01",
+            "2008-00-10",
+            "08-01-01",
+            "2008-01-01-01",
+            "x-1-1",
+        ] {
+            assert_eq!(parse_date(s), None, "{s}");
+        }
+        for s in [
+            "24:00:00",
+            "12:60:00",
+            "12:00:60",
+            "1:2",
+            "a:b:c",
+            "12:00:00.",
+            "-1:00:00",
+        ] {
+            assert_eq!(parse_time(s), None, "{s}");
+        }
+    }
+}
