@@ -321,7 +321,14 @@ impl LarsParams {
             eligible[e.feature] = false;
         }
         let core = Core::new(&xs, use_gram);
-        let path = core.run(self, &ys, eligible, &mut excluded);
+        let mut path = core.run(self, &ys, eligible, &mut excluded);
+        if matches!(
+            path.stop,
+            StopReason::Complete | StopReason::CorrelationVanished
+        ) && let Some(last) = path.coefs.last_mut()
+        {
+            core.refine(&path.active, &path.chol, &ys, last);
+        }
         excluded.sort_by_key(|e| e.feature);
 
         // --- back to the original scale ---------------------------------------------------
@@ -525,6 +532,7 @@ struct Path {
     events: Vec<PathEvent>,
     active: Vec<usize>,
     stop: StopReason,
+    chol: CholeskyFactor,
 }
 
 struct Core<'a> {
@@ -596,6 +604,34 @@ impl<'a> Core<'a> {
         }
     }
 
+    /// Iterative refinement of the least-squares fit on the active set at the end of a full
+    /// path: `beta_A += G_AA^{-1} X_A^T (y - X_A beta_A)`, with the residual recomputed from
+    /// `X` each time. The path's incremental updates work on the normal equations, whose
+    /// rounding grows with cond(X)^2; two refinement sweeps bring the end point to the
+    /// accuracy of a least-squares solve (cond(X) * eps for a small residual).
+    fn refine(&self, active: &[usize], chol: &CholeskyFactor, ys: &[f64], beta: &mut [f64]) {
+        if active.is_empty() || chol.len() != active.len() {
+            return;
+        }
+        for _ in 0..2 {
+            let mut r = ys.to_vec();
+            for &k in active {
+                let bk = beta[k];
+                for (ri, xi) in r.iter_mut().zip(self.col(k)) {
+                    *ri -= bk * xi;
+                }
+            }
+            let mut delta: Vec<f64> = active.iter().map(|&k| dot(self.col(k), &r)).collect();
+            chol.solve_in_place(&mut delta);
+            if delta.iter().any(|d| !d.is_finite()) {
+                return;
+            }
+            for (&k, d) in active.iter().zip(&delta) {
+                beta[k] += d;
+            }
+        }
+    }
+
     fn run(
         &self,
         params: &LarsParams,
@@ -633,12 +669,13 @@ impl<'a> Core<'a> {
         let mut scratch = Vec::new();
         let mut a = vec![0.0; p];
 
-        let finish = |alphas, coefs, events, active, stop| Path {
+        let finish = |alphas, coefs, events, active, stop, chol| Path {
             alphas,
             coefs,
             events,
             active,
             stop,
+            chol,
         };
 
         if c0.is_nan() || c0 <= 0.0 {
@@ -649,11 +686,12 @@ impl<'a> Core<'a> {
                 events,
                 active,
                 StopReason::CorrelationVanished,
+                chol,
             );
         }
         if c0 / nf <= params.alpha_min {
             alphas[0] = params.alpha_min;
-            return finish(alphas, coefs, events, active, StopReason::AlphaMin);
+            return finish(alphas, coefs, events, active, StopReason::AlphaMin, chol);
         }
 
         loop {
@@ -664,10 +702,11 @@ impl<'a> Core<'a> {
                     events,
                     active,
                     StopReason::CorrelationVanished,
+                    chol,
                 );
             }
             if params.max_steps.is_some_and(|m| step >= m) {
-                return finish(alphas, coefs, events, active, StopReason::MaxSteps);
+                return finish(alphas, coefs, events, active, StopReason::MaxSteps, chol);
             }
             step += 1;
 
@@ -709,6 +748,7 @@ impl<'a> Core<'a> {
                     events,
                     active,
                     StopReason::CorrelationVanished,
+                    chol,
                 );
             }
 
@@ -723,6 +763,7 @@ impl<'a> Core<'a> {
                     events,
                     active,
                     StopReason::NumericalBreakdown,
+                    chol,
                 );
             }
             let aa = 1.0 / q.sqrt();
@@ -820,7 +861,7 @@ impl<'a> Core<'a> {
                     .collect();
                 alphas.push(params.alpha_min);
                 coefs.push(knot);
-                return finish(alphas, coefs, events, active, StopReason::AlphaMin);
+                return finish(alphas, coefs, events, active, StopReason::AlphaMin, chol);
             }
             alphas.push(alpha);
             coefs.push(beta.clone());
@@ -830,7 +871,7 @@ impl<'a> Core<'a> {
                 } else {
                     StopReason::Complete
                 };
-                return finish(alphas, coefs, events, active, stop);
+                return finish(alphas, coefs, events, active, stop, chol);
             }
         }
     }

@@ -1,0 +1,260 @@
+//! Group sparse coding (SPEC A.3, eq. 4 and 14-16 of the GSKF paper): one LARS model per
+//! horizon `t = 1..T` on the Hankel design of a series, stacked into the coefficient matrix
+//! `A` (T x m) and the intercepts `b`, so that the multi-step prediction from a window `w` is
+//! `X_hat = A w + b` (eq. 19 with intercepts).
+
+use crate::error::{Error, Result};
+use crate::lars::{Lars, LarsParams};
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use trajpred_core::window::hankel_design;
+
+/// Below this many design entries (rows x m x T) the horizons are fitted one after another:
+/// spawning rayon tasks costs more than it saves.
+const PARALLEL_MIN_WORK: usize = 50_000;
+
+/// Builder of a [`GroupSparseCoder`].
+///
+/// ```
+/// use trajpred_sparse::GroupSparseCoder;
+/// // x_k = sin(0.3 k): an exact order-2 recurrence, so every horizon is predicted exactly
+/// let series: Vec<f64> = (0..200).map(|k| (0.3 * k as f64).sin()).collect();
+/// let gsc = GroupSparseCoder::params(4, 3).fit(&series[..150])?;
+/// assert_eq!(gsc.coefficients().shape(), (3, 4)); // A is T x m
+/// let pred = gsc.predict(&series[146..150])?;
+/// for (t, p) in pred.iter().enumerate() {
+///     assert!((p - series[150 + t]).abs() < 1e-8);
+/// }
+/// # Ok::<(), trajpred_sparse::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GscParams {
+    window: usize,
+    horizons: usize,
+    lars: LarsParams,
+    parallel: bool,
+}
+
+impl GscParams {
+    /// The LARS settings of every horizon's fit (default: [`Lars::params`], the full LAR
+    /// path with intercept and unit-norm columns, whose end is least squares).
+    pub fn lars(mut self, lars: LarsParams) -> Self {
+        self.lars = lars;
+        self
+    }
+
+    /// Fit the horizons in parallel with rayon when the problem is large enough to pay
+    /// (default `true`); `false` always fits them one after another.
+    pub fn parallel(mut self, yes: bool) -> Self {
+        self.parallel = yes;
+        self
+    }
+
+    /// Fits the `T` horizon models on `series` (oldest first).
+    ///
+    /// Horizon `t` uses the windows `(x_j, ..., x_{j+m-1})` whose target `x_{j+m-1+t}` lies in
+    /// the series, `p_t = h - t - m + 1` rows. Needs `h >= m + T + 1` (two rows for the
+    /// longest horizon). A constant series (every window column constant) gives `A = 0` and
+    /// `b` = the mean target, instead of an error.
+    ///
+    /// Errors: [`Error::InvalidParameter`] for `m = 0` or `T = 0`, [`Error::TooShort`],
+    /// [`Error::NonFinite`], and the errors of [`LarsParams::fit`].
+    pub fn fit(&self, series: &[f64]) -> Result<GroupSparseCoder> {
+        let (m, horizons) = (self.window, self.horizons);
+        if m == 0 {
+            return Err(Error::InvalidParameter {
+                name: "window",
+                reason: "window length m must be at least 1".into(),
+            });
+        }
+        if horizons == 0 {
+            return Err(Error::InvalidParameter {
+                name: "horizons",
+                reason: "number of horizons T must be at least 1".into(),
+            });
+        }
+        let needed = m + horizons + 1;
+        if series.len() < needed {
+            return Err(Error::TooShort {
+                what: "series for group sparse coding",
+                needed,
+                got: series.len(),
+            });
+        }
+        if let Some(row) = series.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "series",
+                row,
+                col: 0,
+            });
+        }
+        let work = series.len() * m * horizons;
+        let fit_one = |t: usize| self.fit_horizon(series, t);
+        let models: Vec<HorizonModel> =
+            if self.parallel && horizons > 1 && work >= PARALLEL_MIN_WORK {
+                (1..=horizons)
+                    .into_par_iter()
+                    .map(fit_one)
+                    .collect::<Result<_>>()?
+            } else {
+                (1..=horizons).map(fit_one).collect::<Result<_>>()?
+            };
+        let a = DMatrix::from_fn(horizons, m, |t, k| models[t].coef[k]);
+        let b = DVector::from_fn(horizons, |t, _| models[t].intercept);
+        let residual_variances = models.iter().map(|h| h.residual_variance).collect();
+        let paths = models.into_iter().map(|h| h.path).collect();
+        Ok(GroupSparseCoder {
+            params: self.clone(),
+            a,
+            b,
+            residual_variances,
+            paths,
+        })
+    }
+
+    fn fit_horizon(&self, series: &[f64], t: usize) -> Result<HorizonModel> {
+        let d = hankel_design(series, self.window, t).map_err(|e| Error::InvalidParameter {
+            name: "series",
+            reason: e.to_string(),
+        })?;
+        let y = d.target.as_slice();
+        let rows = y.len() as f64;
+        let (coef, intercept, path) = match self.lars.fit(&d.design, y) {
+            Ok(fit) => (fit.coef(), fit.intercept(), Some(fit)),
+            Err(Error::AllColumnsConstant { .. }) => {
+                let mean = y.iter().sum::<f64>() / rows;
+                (DVector::zeros(self.window), mean, None)
+            }
+            Err(e) => return Err(e),
+        };
+        let fitted = &d.design * &coef;
+        let residual_variance = y
+            .iter()
+            .zip(fitted.iter())
+            .map(|(yi, fi)| {
+                let e = yi - fi - intercept;
+                e * e
+            })
+            .sum::<f64>()
+            / rows;
+        Ok(HorizonModel {
+            coef: coef.iter().copied().collect(),
+            intercept,
+            residual_variance,
+            path,
+        })
+    }
+}
+
+struct HorizonModel {
+    coef: Vec<f64>,
+    intercept: f64,
+    residual_variance: f64,
+    path: Option<Lars>,
+}
+
+/// The fitted group sparse coder: `A` (T x m), `b` (T) and the per-horizon LARS paths.
+///
+/// Row `t - 1` of `A` and entry `t - 1` of `b` predict `x_{i+t}` from the window
+/// `w_i = (x_{i-m+1}, ..., x_i)` (oldest first): `x_hat_{i+t} = A[t-1, :] . w_i + b[t-1]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GroupSparseCoder {
+    params: GscParams,
+    a: DMatrix<f64>,
+    b: DVector<f64>,
+    residual_variances: Vec<f64>,
+    paths: Vec<Option<Lars>>,
+}
+
+impl GroupSparseCoder {
+    /// A builder for window length `m` and `horizons` = T steps ahead (T may exceed m).
+    pub fn params(m: usize, horizons: usize) -> GscParams {
+        GscParams {
+            window: m,
+            horizons,
+            lars: Lars::params(),
+            parallel: true,
+        }
+    }
+
+    /// Window length m.
+    pub fn window(&self) -> usize {
+        self.params.window
+    }
+
+    /// Number of horizons T.
+    pub fn horizons(&self) -> usize {
+        self.params.horizons
+    }
+
+    /// The coefficient matrix `A` (T x m): row `t - 1` is the horizon-`t` model, column `k`
+    /// multiplies the `k`-th oldest value of the window.
+    pub fn coefficients(&self) -> &DMatrix<f64> {
+        &self.a
+    }
+
+    /// The intercepts `b` (length T).
+    pub fn intercepts(&self) -> &DVector<f64> {
+        &self.b
+    }
+
+    /// Per horizon, the mean squared training residual `sum_j e_j^2 / p_t` of that horizon's
+    /// model on its own design (the default diagonal of R in the GSKF).
+    pub fn residual_variances(&self) -> &[f64] {
+        &self.residual_variances
+    }
+
+    /// The LARS path of horizon `t` (1-based), or `None` for a constant series (no path was
+    /// needed) or `t` out of range.
+    pub fn path(&self, t: usize) -> Option<&Lars> {
+        t.checked_sub(1)
+            .and_then(|i| self.paths.get(i))
+            .and_then(Option::as_ref)
+    }
+
+    /// The T-step prediction `A w + b` from a window of the m most recent values, oldest
+    /// first.
+    pub fn predict(&self, window: &[f64]) -> Result<Vec<f64>> {
+        let m = self.window();
+        if window.len() != m {
+            return Err(Error::DimensionMismatch {
+                what: "window length vs m",
+                expected: m,
+                got: window.len(),
+            });
+        }
+        if let Some(row) = window.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "window",
+                row,
+                col: 0,
+            });
+        }
+        Ok((0..self.horizons())
+            .map(|t| {
+                self.b[t]
+                    + self
+                        .a
+                        .row(t)
+                        .iter()
+                        .zip(window)
+                        .map(|(a, w)| a * w)
+                        .sum::<f64>()
+            })
+            .collect())
+    }
+
+    /// The T-step prediction from the last m values of `history`.
+    pub fn predict_next(&self, history: &[f64]) -> Result<Vec<f64>> {
+        let m = self.window();
+        if history.len() < m {
+            return Err(Error::TooShort {
+                what: "history",
+                needed: m,
+                got: history.len(),
+            });
+        }
+        self.predict(&history[history.len() - m..])
+    }
+}
