@@ -1,0 +1,361 @@
+//! The evaluation harness: rolling-origin multi-step evaluation of predictors over many
+//! trajectories.
+//!
+//! For every test trajectory and every origin `o` (from `history - 1`, every `stride` points,
+//! while `o + horizon` is inside the trajectory) the predictor gets the `history` points
+//! ending at `o` and forecasts `horizon` steps; these are scored against the points
+//! `o + 1 ..= o + horizon`. Trajectories are processed in parallel (rayon) in fixed-size
+//! chunks and their partial sums are combined in trajectory order, so results do not depend
+//! on the number of threads and memory holds one chunk of trajectories at a time.
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::time::Instant;
+use trajpred_core::{Error, Predictor, Result, Trajectory};
+
+/// How to evaluate.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct EvalConfig {
+    /// Points given to the predictor at each origin (the paper: 10..50).
+    pub history: usize,
+    /// Steps forecast at each origin (the paper: 1..5).
+    pub horizon: usize,
+    /// Distance between consecutive origins in a trajectory.
+    pub stride: usize,
+    /// Hit threshold in the data's units (the paper: 25 m).
+    pub threshold: f64,
+    /// At most this many origins per trajectory (`None`: all).
+    pub max_origins_per_trajectory: Option<usize>,
+}
+
+impl Default for EvalConfig {
+    fn default() -> Self {
+        EvalConfig {
+            history: 20,
+            horizon: 5,
+            stride: 1,
+            threshold: 25.0,
+            max_origins_per_trajectory: None,
+        }
+    }
+}
+
+impl EvalConfig {
+    fn validate(&self) -> Result<()> {
+        let bad = |name, reason: &str| {
+            Err(Error::InvalidParameter {
+                name,
+                reason: reason.into(),
+            })
+        };
+        if self.history == 0 {
+            return bad("history", "must be at least 1");
+        }
+        if self.horizon == 0 {
+            return bad("horizon", "must be at least 1");
+        }
+        if self.stride == 0 {
+            return bad("stride", "must be at least 1");
+        }
+        if !(self.threshold.is_finite() && self.threshold > 0.0) {
+            return bad("threshold", "must be finite and positive");
+        }
+        Ok(())
+    }
+
+    /// The forecast origins of a trajectory of `len` points.
+    pub fn origins(&self, len: usize) -> impl Iterator<Item = usize> + use<> {
+        let (start, h, stride) = (self.history - 1, self.horizon, self.stride);
+        let max = self.max_origins_per_trajectory.unwrap_or(usize::MAX);
+        (start..len.saturating_sub(h)).step_by(stride).take(max)
+    }
+}
+
+/// Partial sums for one trajectory (or many, once merged).
+#[derive(Debug, Clone, Default, PartialEq)]
+struct Sums {
+    forecasts: usize,
+    failures: usize,
+    first_failure: Option<String>,
+    err: Vec<f64>,
+    err_sq: Vec<f64>,
+    hits: Vec<usize>,
+}
+
+impl Sums {
+    fn new(h: usize) -> Self {
+        Sums {
+            err: vec![0.0; h],
+            err_sq: vec![0.0; h],
+            hits: vec![0; h],
+            ..Default::default()
+        }
+    }
+
+    fn merge(&mut self, o: Sums) {
+        self.forecasts += o.forecasts;
+        self.failures += o.failures;
+        if self.first_failure.is_none() {
+            self.first_failure = o.first_failure;
+        }
+        for k in 0..self.err.len() {
+            self.err[k] += o.err[k];
+            self.err_sq[k] += o.err_sq[k];
+            self.hits[k] += o.hits[k];
+        }
+    }
+}
+
+/// Errors of one method, per forecast step and pooled over every step.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MethodReport {
+    /// The predictor's name.
+    pub method: String,
+    /// Trajectories evaluated (those long enough for at least one origin).
+    pub trajectories: usize,
+    /// Forecasts made.
+    pub forecasts: usize,
+    /// Forecasts the predictor refused with an error (counted, never silently dropped).
+    pub failures: usize,
+    /// The first of those errors, if any.
+    pub first_failure: Option<String>,
+    /// Mean Euclidean error at step k (k = 1..=horizon).
+    pub mean_euclidean: Vec<f64>,
+    /// Root mean square Euclidean error at step k.
+    pub rms_euclidean: Vec<f64>,
+    /// Share of step-k predictions within the threshold.
+    pub hit_rate: Vec<f64>,
+    /// Mean Euclidean error over every step of every forecast (ADE).
+    pub mean_euclidean_all: f64,
+    /// Hit rate over every step.
+    pub hit_rate_all: f64,
+    /// Wall time of fitting, seconds.
+    pub fit_seconds: f64,
+    /// Wall time of the forecasts, seconds.
+    pub forecast_seconds: f64,
+}
+
+impl MethodReport {
+    /// Forecasts per second of wall time.
+    pub fn throughput(&self) -> f64 {
+        self.forecasts as f64 / self.forecast_seconds.max(1e-12)
+    }
+}
+
+/// The history the harness gives a predictor at `origin`: the `history` points ending at
+/// `origin` (inclusive). Nothing after the origin is in it.
+pub fn history_at(tr: &Trajectory, origin: usize, history: usize) -> Result<Trajectory> {
+    let start = (origin + 1).checked_sub(history).ok_or(Error::TooShort {
+        what: "trajectory before the origin",
+        needed: history,
+        got: origin + 1,
+    })?;
+    tr.slice(start..origin + 1)
+}
+
+fn evaluate_one(p: &dyn Predictor, tr: &Trajectory, cfg: &EvalConfig) -> Sums {
+    let mut s = Sums::new(cfg.horizon);
+    for o in cfg.origins(tr.len()) {
+        let history = match history_at(tr, o, cfg.history) {
+            Ok(h) => h,
+            Err(e) => {
+                s.failures += 1;
+                s.first_failure.get_or_insert_with(|| e.to_string());
+                continue;
+            }
+        };
+        match p.forecast(&history, cfg.horizon) {
+            Ok(f) if f.horizon() == cfg.horizon && f.dim() == tr.dim() => {
+                s.forecasts += 1;
+                for k in 0..cfg.horizon {
+                    let truth = tr.point(o + 1 + k);
+                    let e2: f64 = f
+                        .step(k + 1)
+                        .iter()
+                        .zip(truth.iter())
+                        .map(|(a, b)| (a - b) * (a - b))
+                        .sum();
+                    let e = e2.sqrt();
+                    s.err[k] += e;
+                    s.err_sq[k] += e2;
+                    s.hits[k] += usize::from(e < cfg.threshold);
+                }
+            }
+            Ok(f) => {
+                s.failures += 1;
+                s.first_failure.get_or_insert_with(|| {
+                    format!(
+                        "forecast of {} steps x {} axes, expected {} x {}",
+                        f.horizon(),
+                        f.dim(),
+                        cfg.horizon,
+                        tr.dim()
+                    )
+                });
+            }
+            Err(e) => {
+                s.failures += 1;
+                s.first_failure.get_or_insert_with(|| e.to_string());
+            }
+        }
+    }
+    s
+}
+
+/// Number of trajectories evaluated in parallel at a time (and held in memory by
+/// [`evaluate_stream`]).
+pub const CHUNK: usize = 64;
+
+/// Evaluates a fitted predictor on test trajectories. `progress` is called with the number of
+/// trajectories done so far, after each chunk.
+pub fn evaluate(
+    predictor: &dyn Predictor,
+    test: &[Trajectory],
+    cfg: &EvalConfig,
+    progress: Option<&(dyn Fn(usize) + Sync)>,
+) -> Result<MethodReport> {
+    evaluate_stream(predictor, test.iter().cloned().map(Ok), cfg, progress)
+}
+
+/// Like [`evaluate`], over a stream of trajectories (e.g. a loader reading one file at a
+/// time), holding at most [`CHUNK`] of them in memory. The first stream error is returned.
+pub fn evaluate_stream(
+    predictor: &dyn Predictor,
+    test: impl Iterator<Item = Result<Trajectory>>,
+    cfg: &EvalConfig,
+    progress: Option<&(dyn Fn(usize) + Sync)>,
+) -> Result<MethodReport> {
+    cfg.validate()?;
+    let start = Instant::now();
+    let mut total = Sums::new(cfg.horizon);
+    let (mut done, mut used) = (0usize, 0usize);
+    let mut chunk = Vec::with_capacity(CHUNK);
+    let mut test = test.peekable();
+    while test.peek().is_some() {
+        chunk.clear();
+        for tr in test.by_ref().take(CHUNK) {
+            chunk.push(tr?);
+        }
+        let parts: Vec<Sums> = chunk
+            .par_iter()
+            .map(|tr| evaluate_one(predictor, tr, cfg))
+            .collect();
+        for part in parts {
+            if part.forecasts + part.failures > 0 {
+                used += 1;
+            }
+            total.merge(part);
+        }
+        done += chunk.len();
+        if let Some(cb) = progress {
+            cb(done);
+        }
+    }
+    let n = total.forecasts as f64;
+    let per = |v: &[f64]| -> Vec<f64> {
+        v.iter()
+            .map(|x| if n > 0.0 { x / n } else { f64::NAN })
+            .collect()
+    };
+    let mean_euclidean = per(&total.err);
+    let rms_euclidean = per(&total.err_sq).into_iter().map(f64::sqrt).collect();
+    let hit_rate = total
+        .hits
+        .iter()
+        .map(|&h| if n > 0.0 { h as f64 / n } else { f64::NAN })
+        .collect();
+    let all_n = n * cfg.horizon as f64;
+    Ok(MethodReport {
+        method: predictor.name().to_string(),
+        trajectories: used,
+        forecasts: total.forecasts,
+        failures: total.failures,
+        first_failure: total.first_failure,
+        mean_euclidean,
+        rms_euclidean,
+        hit_rate,
+        mean_euclidean_all: total.err.iter().sum::<f64>() / all_n,
+        hit_rate_all: total.hits.iter().sum::<usize>() as f64 / all_n,
+        fit_seconds: 0.0,
+        forecast_seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// Fits `predictor` on `train`, then evaluates it on `test`, timing both.
+pub fn fit_and_evaluate(
+    predictor: &mut dyn Predictor,
+    train: &[Trajectory],
+    test: &[Trajectory],
+    cfg: &EvalConfig,
+    progress: Option<&(dyn Fn(usize) + Sync)>,
+) -> Result<MethodReport> {
+    let t0 = Instant::now();
+    predictor.fit(train)?;
+    let fit_seconds = t0.elapsed().as_secs_f64();
+    let mut report = evaluate(predictor, test, cfg, progress)?;
+    report.fit_seconds = fit_seconds;
+    Ok(report)
+}
+
+/// How to split trajectories into training and test sets.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Split {
+    /// The first `train_fraction` of every trajectory trains, the rest tests.
+    ByTime {
+        /// Share of each trajectory's points used for training.
+        train_fraction: f64,
+    },
+    /// A seeded random `train_fraction` of the trajectories trains, the others test.
+    ByTrajectory {
+        /// Share of trajectories used for training.
+        train_fraction: f64,
+        /// Seed of the shuffle.
+        seed: u64,
+    },
+}
+
+/// Splits trajectories into (train, test). Parts too short to form a trajectory are left out.
+pub fn split(
+    trajectories: &[Trajectory],
+    how: Split,
+) -> Result<(Vec<Trajectory>, Vec<Trajectory>)> {
+    use rand::SeedableRng;
+    use rand::seq::SliceRandom;
+    let check = |f: f64| {
+        if f > 0.0 && f < 1.0 {
+            Ok(())
+        } else {
+            Err(Error::InvalidParameter {
+                name: "train_fraction",
+                reason: format!("must be in (0, 1), got {f}"),
+            })
+        }
+    };
+    match how {
+        Split::ByTime { train_fraction } => {
+            check(train_fraction)?;
+            let (mut train, mut test) = (Vec::new(), Vec::new());
+            for tr in trajectories {
+                let cut = (tr.len() as f64 * train_fraction).round() as usize;
+                if cut >= 1 {
+                    train.push(tr.slice(0..cut.min(tr.len()))?);
+                }
+                if cut < tr.len() {
+                    test.push(tr.slice(cut..tr.len())?);
+                }
+            }
+            Ok((train, test))
+        }
+        Split::ByTrajectory {
+            train_fraction,
+            seed,
+        } => {
+            check(train_fraction)?;
+            let mut idx: Vec<usize> = (0..trajectories.len()).collect();
+            idx.shuffle(&mut rand_chacha::ChaCha8Rng::seed_from_u64(seed));
+            let cut = (trajectories.len() as f64 * train_fraction).round() as usize;
+            let pick = |ix: &[usize]| ix.iter().map(|&i| trajectories[i].clone()).collect();
+            Ok((pick(&idx[..cut]), pick(&idx[cut..])))
+        }
+    }
+}

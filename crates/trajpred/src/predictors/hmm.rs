@@ -1,0 +1,432 @@
+//! The HMM motion-state predictor of SPEC B.2 (the KF-dynamic paper's "HMM" baseline).
+//!
+//! Training displacement vectors are clustered into K motion states by k-means; the states of
+//! consecutive displacements give a transition matrix by counting (observed states, Laplace
+//! smoothing); an isotropic Gaussian around each centroid is the emission model. To forecast,
+//! the state distribution is forward-filtered over the history's displacements, pushed through
+//! the transition matrix step by step, and the expected centroid is added to the last point.
+
+use super::invalid;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+use trajpred_core::{Error, Forecast, Predictor, Result, Trajectory, check_forecast_args};
+
+/// Parameters of [`Hmm`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HmmParams {
+    /// Number of motion states K; `None` chooses it on the training data among `candidates`.
+    pub states: Option<usize>,
+    /// The K tried when `states` is `None`.
+    pub candidates: Vec<usize>,
+    /// Seed of the k-means++ initialisation.
+    pub seed: u64,
+    /// Most Lloyd iterations of k-means.
+    pub max_iterations: usize,
+    /// Most recent displacements used by the forward filter.
+    pub filter_window: usize,
+}
+
+impl Default for HmmParams {
+    fn default() -> Self {
+        HmmParams {
+            states: None,
+            candidates: vec![2, 4, 8, 16],
+            seed: 0,
+            max_iterations: 100,
+            filter_window: 50,
+        }
+    }
+}
+
+/// What [`Hmm::fit`](Predictor::fit) learns.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HmmModel {
+    /// Number of axes of the displacements.
+    pub dim: usize,
+    /// The K centroids (mean displacement of each motion state).
+    pub centroids: Vec<Vec<f64>>,
+    /// Row-stochastic K x K transition matrix, `transition[i][j] = P(s' = j | s = i)`.
+    pub transition: Vec<Vec<f64>>,
+    /// Initial state distribution.
+    pub initial: Vec<f64>,
+    /// Variance of the isotropic Gaussian emission around each centroid.
+    pub emission_variance: f64,
+}
+
+/// HMM motion-state predictor (SPEC B.2). Assumes a uniform sampling step (resample first).
+///
+/// ```
+/// use trajpred::predictors::{Hmm, HmmParams};
+/// use trajpred_core::{Predictor, Trajectory};
+/// // a walker that alternates steps of +1 and +3 along x
+/// let x: Vec<f64> = (0..40).map(|i| (i / 2 * 4 + (i % 2)) as f64).collect();
+/// let tr = Trajectory::uniform(0.0, 1.0, vec![x.clone(), vec![0.0; 40]])?;
+/// let mut p = Hmm::new(HmmParams { states: Some(2), ..Default::default() })?;
+/// p.fit(std::slice::from_ref(&tr))?;
+/// let f = p.forecast(&tr, 2)?;
+/// // the last displacement was +1, so the next is +3 and then +1 (up to the Laplace
+/// // smoothing of the counted transitions: 1 pseudo-count against 19 observed)
+/// assert!((f.step(1)[0] - (x[39] + 3.0)).abs() < 0.2);
+/// assert!((f.step(2)[0] - (x[39] + 4.0)).abs() < 0.4);
+/// # Ok::<(), trajpred_core::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Hmm {
+    params: HmmParams,
+    model: Option<HmmModel>,
+}
+
+impl Hmm {
+    /// A validated, unfitted predictor.
+    pub fn new(params: HmmParams) -> Result<Self> {
+        if params.states == Some(0) {
+            return Err(invalid("states", "K must be at least 1"));
+        }
+        if params.states.is_none()
+            && (params.candidates.is_empty() || params.candidates.contains(&0))
+        {
+            return Err(invalid(
+                "candidates",
+                "need at least one K, each at least 1",
+            ));
+        }
+        if params.max_iterations == 0 {
+            return Err(invalid("max_iterations", "must be at least 1"));
+        }
+        if params.filter_window == 0 {
+            return Err(invalid("filter_window", "must be at least 1"));
+        }
+        Ok(Hmm {
+            params,
+            model: None,
+        })
+    }
+
+    /// The fitted model, if `fit` has run.
+    pub fn model(&self) -> Option<&HmmModel> {
+        self.model.as_ref()
+    }
+}
+
+fn displacements(tr: &Trajectory) -> Vec<Vec<f64>> {
+    (1..tr.len())
+        .map(|i| {
+            let (a, b) = (tr.point(i - 1), tr.point(i));
+            b.iter().zip(a.iter()).map(|(b, a)| b - a).collect()
+        })
+        .collect()
+}
+
+fn sq_dist(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(a, b)| (a - b) * (a - b)).sum()
+}
+
+fn nearest(c: &[Vec<f64>], x: &[f64]) -> usize {
+    let mut best = (0, f64::INFINITY);
+    for (j, cj) in c.iter().enumerate() {
+        let d = sq_dist(cj, x);
+        if d < best.1 {
+            best = (j, d);
+        }
+    }
+    best.0
+}
+
+/// k-means with k-means++ seeding (seeded), Lloyd iterations; an emptied cluster is re-seeded
+/// with the point farthest from its centroid.
+fn kmeans(data: &[Vec<f64>], k: usize, seed: u64, max_iter: usize) -> Vec<Vec<f64>> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut centroids = vec![data[rng.random_range(0..data.len())].clone()];
+    let mut d2: Vec<f64> = data.iter().map(|x| sq_dist(x, &centroids[0])).collect();
+    while centroids.len() < k {
+        let total: f64 = d2.iter().sum();
+        let next = if total > 0.0 {
+            let mut u = rng.random::<f64>() * total;
+            let mut idx = data.len() - 1;
+            for (i, w) in d2.iter().enumerate() {
+                if u < *w {
+                    idx = i;
+                    break;
+                }
+                u -= w;
+            }
+            idx
+        } else {
+            rng.random_range(0..data.len())
+        };
+        centroids.push(data[next].clone());
+        for (d, x) in d2.iter_mut().zip(data) {
+            *d = d.min(sq_dist(x, &centroids[centroids.len() - 1]));
+        }
+    }
+    let dim = data[0].len();
+    let mut assign = vec![usize::MAX; data.len()];
+    for _ in 0..max_iter {
+        let mut changed = false;
+        for (a, x) in assign.iter_mut().zip(data) {
+            let j = nearest(&centroids, x);
+            changed |= *a != j;
+            *a = j;
+        }
+        if !changed {
+            break;
+        }
+        let mut sums = vec![vec![0.0; dim]; k];
+        let mut counts = vec![0usize; k];
+        for (a, x) in assign.iter().zip(data) {
+            counts[*a] += 1;
+            for (s, v) in sums[*a].iter_mut().zip(x) {
+                *s += v;
+            }
+        }
+        for j in 0..k {
+            if counts[j] > 0 {
+                centroids[j] = sums[j].iter().map(|s| s / counts[j] as f64).collect();
+            } else {
+                // re-seed an empty cluster with the worst-fitted point
+                let far = (0..data.len())
+                    .max_by(|&a, &b| {
+                        sq_dist(&data[a], &centroids[assign[a]])
+                            .total_cmp(&sq_dist(&data[b], &centroids[assign[b]]))
+                    })
+                    .unwrap_or(0);
+                centroids[j] = data[far].clone();
+            }
+        }
+    }
+    centroids
+}
+
+fn train(seqs: &[Vec<Vec<f64>>], k: usize, params: &HmmParams) -> Result<HmmModel> {
+    let all: Vec<Vec<f64>> = seqs.iter().flatten().cloned().collect();
+    if all.len() < k {
+        return Err(Error::TooShort {
+            what: "training displacements for the HMM",
+            needed: k,
+            got: all.len(),
+        });
+    }
+    let dim = all[0].len();
+    let centroids = kmeans(&all, k, params.seed, params.max_iterations);
+    // counted transitions with Laplace smoothing
+    let mut counts = vec![vec![1.0; k]; k];
+    let mut initial = vec![1.0; k];
+    let mut sse = 0.0;
+    for seq in seqs {
+        let states: Vec<usize> = seq.iter().map(|d| nearest(&centroids, d)).collect();
+        if let Some(&s0) = states.first() {
+            initial[s0] += 1.0;
+        }
+        for w in states.windows(2) {
+            counts[w[0]][w[1]] += 1.0;
+        }
+        sse += seq
+            .iter()
+            .zip(&states)
+            .map(|(d, &s)| sq_dist(d, &centroids[s]))
+            .sum::<f64>();
+    }
+    let transition = counts
+        .into_iter()
+        .map(|row| {
+            let s: f64 = row.iter().sum();
+            row.into_iter().map(|c| c / s).collect()
+        })
+        .collect();
+    let total: f64 = initial.iter().sum();
+    let initial = initial.into_iter().map(|c| c / total).collect();
+    // isotropic emission variance; floored so identical displacements do not give zero
+    let scale = all.iter().map(|d| sq_dist(d, &vec![0.0; dim])).sum::<f64>() / all.len() as f64;
+    let emission_variance = (sse / (all.len() * dim) as f64).max(1e-12 * scale.max(1e-12));
+    Ok(HmmModel {
+        dim,
+        centroids,
+        transition,
+        initial,
+        emission_variance,
+    })
+}
+
+impl HmmModel {
+    /// Forward-filtered distribution of the state of the last displacement.
+    fn filter(&self, disp: &[Vec<f64>]) -> Vec<f64> {
+        let k = self.centroids.len();
+        let mut alpha = self.initial.clone();
+        for (t, d) in disp.iter().enumerate() {
+            let prior: Vec<f64> = if t == 0 {
+                self.initial.clone()
+            } else {
+                (0..k)
+                    .map(|j| (0..k).map(|i| alpha[i] * self.transition[i][j]).sum())
+                    .collect()
+            };
+            let log_e: Vec<f64> = self
+                .centroids
+                .iter()
+                .map(|c| -sq_dist(c, d) / (2.0 * self.emission_variance))
+                .collect();
+            let m = log_e.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let mut post: Vec<f64> = prior
+                .iter()
+                .zip(&log_e)
+                .map(|(p, l)| p * (l - m).exp())
+                .collect();
+            let s: f64 = post.iter().sum();
+            if s > 0.0 && s.is_finite() {
+                post.iter_mut().for_each(|p| *p /= s);
+                alpha = post;
+            } else {
+                alpha = prior;
+            }
+        }
+        alpha
+    }
+
+    /// Expected displacements of the next `horizon` steps, given the filtered distribution.
+    fn expected_displacements(&self, mut dist: Vec<f64>, horizon: usize) -> Vec<Vec<f64>> {
+        let k = self.centroids.len();
+        (0..horizon)
+            .map(|_| {
+                dist = (0..k)
+                    .map(|j| (0..k).map(|i| dist[i] * self.transition[i][j]).sum())
+                    .collect();
+                (0..self.dim)
+                    .map(|a| (0..k).map(|j| dist[j] * self.centroids[j][a]).sum())
+                    .collect()
+            })
+            .collect()
+    }
+
+    fn predict(&self, history: &Trajectory, horizon: usize, window: usize) -> Vec<Vec<f64>> {
+        let disp = displacements(history);
+        let recent = &disp[disp.len().saturating_sub(window)..];
+        let steps = if recent.is_empty() {
+            // no displacement observed yet: the first one is distributed as `initial`
+            self.expected_from_initial(self.initial.clone(), horizon)
+        } else {
+            self.expected_displacements(self.filter(recent), horizon)
+        };
+        self.cumulate(history, steps)
+    }
+
+    fn expected_from_initial(&self, first: Vec<f64>, horizon: usize) -> Vec<Vec<f64>> {
+        let mean_of = |dist: &[f64]| -> Vec<f64> {
+            (0..self.dim)
+                .map(|a| {
+                    dist.iter()
+                        .zip(&self.centroids)
+                        .map(|(p, c)| p * c[a])
+                        .sum()
+                })
+                .collect()
+        };
+        let mut out = vec![mean_of(&first)];
+        if horizon > 1 {
+            out.extend(self.expected_displacements(first, horizon - 1));
+        }
+        out
+    }
+
+    fn cumulate(&self, history: &Trajectory, disp: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
+        let mut pos = history.last_point().to_vec();
+        disp.into_iter()
+            .map(|d| {
+                pos.iter_mut().zip(&d).for_each(|(p, d)| *p += d);
+                pos.clone()
+            })
+            .collect()
+    }
+}
+
+impl Predictor for Hmm {
+    fn name(&self) -> &str {
+        "hmm"
+    }
+
+    fn fit(&mut self, train_set: &[Trajectory]) -> Result<()> {
+        let seqs: Vec<Vec<Vec<f64>>> = train_set
+            .iter()
+            .map(displacements)
+            .filter(|s| !s.is_empty())
+            .collect();
+        if seqs.is_empty() {
+            return Err(Error::Empty {
+                what: "training displacements (every trajectory has a single point)",
+            });
+        }
+        let dim = seqs[0][0].len();
+        if let Some(bad) = seqs.iter().find(|s| s[0].len() != dim) {
+            return Err(Error::DimensionMismatch {
+                what: "training trajectories",
+                expected: dim,
+                got: bad[0].len(),
+            });
+        }
+        let k = match self.params.states {
+            Some(k) => k,
+            None => choose_k(&seqs, &self.params)?,
+        };
+        self.model = Some(train(&seqs, k, &self.params)?);
+        Ok(())
+    }
+
+    fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
+        check_forecast_args(history, horizon, 1)?;
+        let model = self.model.as_ref().ok_or_else(|| Error::NotFitted {
+            method: "hmm".into(),
+        })?;
+        if history.dim() != model.dim {
+            return Err(Error::DimensionMismatch {
+                what: "history vs fitted HMM",
+                expected: model.dim,
+                got: history.dim(),
+            });
+        }
+        Forecast::new(
+            history.dim(),
+            model.predict(history, horizon, self.params.filter_window),
+        )
+    }
+}
+
+/// Chooses K among the candidates by one-step-ahead error on held-out displacements: the last
+/// 20% of every training sequence (never the test data).
+fn choose_k(seqs: &[Vec<Vec<f64>>], params: &HmmParams) -> Result<usize> {
+    let (fit, held): (Vec<_>, Vec<_>) = seqs
+        .iter()
+        .map(|s| {
+            let cut = (s.len() * 4).div_ceil(5).max(1);
+            (s[..cut].to_vec(), s[cut..].to_vec())
+        })
+        .unzip();
+    let total_fit: usize = fit.iter().map(Vec::len).sum();
+    let mut best: Option<(usize, f64)> = None;
+    for &k in &params.candidates {
+        if k > total_fit {
+            continue;
+        }
+        let model = train(&fit, k, params)?;
+        let (mut err, mut n) = (0.0, 0usize);
+        for (f, h) in fit.iter().zip(&held) {
+            let mut seq = f.clone();
+            for d in h {
+                let start = seq.len().saturating_sub(params.filter_window);
+                let dist = model.filter(&seq[start..]);
+                let pred = &model.expected_displacements(dist, 1)[0];
+                err += sq_dist(pred, d).sqrt();
+                n += 1;
+                seq.push(d.clone());
+            }
+        }
+        let score = if n > 0 { err / n as f64 } else { f64::INFINITY };
+        if best.is_none_or(|(_, s)| score < s) {
+            best = Some((k, score));
+        }
+    }
+    best.map(|(k, _)| k).ok_or(Error::TooShort {
+        what: "training displacements for the smallest candidate K",
+        needed: params.candidates.iter().copied().min().unwrap_or(1),
+        got: total_fit,
+    })
+}

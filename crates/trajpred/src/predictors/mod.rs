@@ -1,0 +1,30 @@
+//! Every method of the four papers as a [`Predictor`](trajpred_core::Predictor).
+
+mod hmm;
+mod kf_dynamic;
+mod poly;
+
+pub use hmm::{Hmm, HmmParams};
+pub use kf_dynamic::{Continuation, KfDynamic, KfDynamicParams, NaiveKf};
+pub use poly::{PolyFit, PolyFitParams};
+
+use trajpred_core::{Error, Trajectory};
+
+pub(crate) fn invalid(name: &'static str, reason: impl Into<String>) -> Error {
+    Error::InvalidParameter {
+        name,
+        reason: reason.into(),
+    }
+}
+
+/// The sampling interval a predictor steps by: the mean interval of the last `window` points
+/// of the history (at least two points; a single point gives 1 s).
+pub(crate) fn step_interval(history: &Trajectory, window: usize) -> f64 {
+    let n = history.len();
+    let w = window.clamp(2, n.max(2));
+    if n < 2 {
+        return 1.0;
+    }
+    let t = history.times();
+    (t[n - 1] - t[n - w.min(n)]) / (w.min(n) - 1) as f64
+}

@@ -1,0 +1,97 @@
+//! Every predictor by name, for the CLI, the harness and the reproduction: one place that
+//! turns `"kf-dynamic"` into a `Box<dyn Predictor>`.
+
+use crate::predictors::*;
+use serde::{Deserialize, Serialize};
+use trajpred_core::{Error, Predictor, Result};
+
+/// Options shared by the predictors built by name (each method reads the ones it uses).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MethodOptions {
+    /// `Q = q I` of the KF-dynamic paper's filters.
+    pub kf_q: f64,
+    /// Points fitted by the polynomial baselines.
+    pub poly_points: usize,
+    /// Seed of every randomised method.
+    pub seed: u64,
+}
+
+impl Default for MethodOptions {
+    fn default() -> Self {
+        MethodOptions {
+            kf_q: 10.0,
+            poly_points: 5,
+            seed: 0,
+        }
+    }
+}
+
+/// A method the registry can build: its name and a one-line description.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MethodInfo {
+    /// The name used on the command line.
+    pub name: &'static str,
+    /// What it is.
+    pub description: &'static str,
+}
+
+/// Every method the registry knows, in a stable order.
+pub const METHODS: &[MethodInfo] = &[
+    MethodInfo {
+        name: "kf-dynamic",
+        description: "KF-dynamic paper: predictor form of the Kalman filter (eq. 13-15), CV model",
+    },
+    MethodInfo {
+        name: "kf-dynamic-4d",
+        description: "KF dynamic with the 4-D position + velocity observation (R = I)",
+    },
+    MethodInfo {
+        name: "naive-kf",
+        description: "Kalman filter through the history, then uncorrected CV extrapolation",
+    },
+    MethodInfo {
+        name: "poly1",
+        description: "least-squares line through the last N points, extrapolated",
+    },
+    MethodInfo {
+        name: "poly2",
+        description: "least-squares parabola through the last N points, extrapolated",
+    },
+    MethodInfo {
+        name: "hmm",
+        description: "k-means motion states + HMM forward filter (K chosen on training data)",
+    },
+];
+
+/// Builds the predictor called `name` (see [`METHODS`]); an unknown name is an
+/// [`Error::InvalidParameter`] listing the known ones.
+pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
+    Ok(match name {
+        "kf-dynamic" => Box::new(KfDynamic::new(KfDynamicParams::paper_position(opts.kf_q))?),
+        "kf-dynamic-4d" => Box::new(KfDynamic::new(KfDynamicParams::paper_position_velocity(
+            opts.kf_q,
+        ))?),
+        "naive-kf" => Box::new(NaiveKf::new(KfDynamicParams::paper_position(opts.kf_q))?),
+        "poly1" | "poly2" => Box::new(PolyFit::new(PolyFitParams {
+            degree: if name == "poly1" { 1 } else { 2 },
+            points: opts.poly_points,
+        })?),
+        "hmm" => Box::new(Hmm::new(HmmParams {
+            seed: opts.seed,
+            ..Default::default()
+        })?),
+        _ => {
+            return Err(Error::InvalidParameter {
+                name: "method",
+                reason: format!(
+                    "unknown method `{name}`; known: {}",
+                    METHODS
+                        .iter()
+                        .map(|m| m.name)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            });
+        }
+    })
+}
