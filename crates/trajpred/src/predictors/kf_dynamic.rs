@@ -94,12 +94,15 @@ fn kalman_error(method: &str) -> impl Fn(trajpred_kalman::KalmanError) -> Error 
     move |e| Error::method(method, e)
 }
 
+/// The CV filter for a history, its observations and the initial one-step prediction.
+struct Setup {
+    kf: DynKf,
+    z: Vec<DVector<f64>>,
+    initial: Gaussian<f64, Dyn>,
+}
+
 /// Builds the CV filter for `history` and its observation sequence.
-fn build(
-    params: &KfDynamicParams,
-    history: &Trajectory,
-    method: &str,
-) -> Result<(DynKf, Vec<DVector<f64>>, Gaussian<f64, Dyn>)> {
+fn build(params: &KfDynamicParams, history: &Trajectory, method: &str) -> Result<Setup> {
     let d = history.dim();
     let n = 2 * d;
     let dt = step_interval(history, history.len());
@@ -136,7 +139,7 @@ fn build(
         x0[a] = z[0][a];
     }
     let initial = Gaussian::new(x0, DMatrix::identity(n, n) * params.p0)?;
-    Ok((kf, z, initial))
+    Ok(Setup { kf, z, initial })
 }
 
 fn to_forecast(states: &[Gaussian<f64, Dyn>], d: usize) -> Result<Forecast> {
@@ -187,7 +190,7 @@ impl Predictor for KfDynamic {
     }
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
         check_forecast_args(history, horizon, self.min_history())?;
-        let (kf, z, initial) = build(&self.params, history, self.name())?;
+        let Setup { kf, z, initial } = build(&self.params, history, self.name())?;
         let last = z.len() - 1;
         let mut prediction = initial;
         for zk in &z[..last] {
@@ -234,7 +237,7 @@ impl Predictor for NaiveKf {
     }
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
         check_forecast_args(history, horizon, self.min_history())?;
-        let (kf, z, initial) = build(&self.params, history, self.name())?;
+        let Setup { kf, z, initial } = build(&self.params, history, self.name())?;
         // the first observation updates the initial state directly (no prediction before it)
         let first = kf
             .update(&initial, &z[0])
