@@ -118,8 +118,8 @@ pub fn parse_json(
             for (row, r) in rows {
                 c.report.records_read += 1;
                 match bad.remove(&row) {
-                    Some(e) => c.malformed(row + 1, e)?,
-                    None => records.push((row + 1, r)),
+                    Some(e) => c.malformed(row.saturating_add(1), e)?,
+                    None => records.push((row.saturating_add(1), r)),
                 }
             }
         }

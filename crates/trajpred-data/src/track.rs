@@ -181,6 +181,10 @@ pub struct Track {
     pub trajectory: Trajectory,
 }
 
+/// Altitudes beyond ±10,000 km are invalid coordinates (they are not altitudes, and would
+/// overflow the geodesy).
+pub const MAX_ABS_ALTITUDE: f64 = 1.0e7;
+
 /// A parsed point before cleaning; `alt` in metres.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct RawPoint {
@@ -260,7 +264,7 @@ impl Cleaner<'_> {
                         .skip(self.file, p.line, SkipReason::MissingValue, "altitude");
                     return Ok(false);
                 }
-                Some(h) if !h.is_finite() => {
+                Some(h) if !(h.is_finite() && h.abs() <= MAX_ABS_ALTITUDE) => {
                     self.report
                         .skip(self.file, p.line, SkipReason::InvalidCoordinate, "altitude");
                     return Ok(false);
