@@ -3,7 +3,7 @@
 //! update forms [`CovarianceUpdate`], and the RTS smoother [`Smoother`].
 
 use crate::error::{KalmanError, Result};
-use crate::linalg::{check_dim, check_finite, check_state, cholesky, log_det, symmetrise};
+use crate::linalg::{Chol, check_dim, check_finite, check_state, cholesky, symmetrise};
 use crate::model::Observation;
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
@@ -104,6 +104,18 @@ where
     /// The update of `prior` by the observation `z`.
     fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>>;
 
+    /// The update of a prior that this filter's own [`Filter::predict`] just returned: the
+    /// same as [`Filter::update`] but without re-validating `prior` (`predict` validated its
+    /// input, and its output is symmetric positive semi-definite by construction).
+    /// [`Filter::step`] uses it. With any other prior, call [`Filter::update`].
+    fn update_predicted(
+        &self,
+        prior: &Gaussian<T, D>,
+        z: &OVector<T, M>,
+    ) -> Result<Update<T, D, M>> {
+        self.update(prior, z)
+    }
+
     /// The prediction with a known control effect `B u` (already mapped to the state space)
     /// added to the predicted mean: `x(k|k-1) = f(x) + B u`. The covariance is unchanged,
     /// since the control input carries no noise.
@@ -120,10 +132,11 @@ where
     }
 
     /// Predict, then update when `z` is `Some` (a missing observation is `None`).
+    #[inline(always)]
     fn step(&self, state: &Gaussian<T, D>, z: Option<&OVector<T, M>>) -> Result<Step<T, D, M>> {
         let prior = self.predict(state)?;
         let update = match z {
-            Some(z) => Some(self.update(&prior, z)?),
+            Some(z) => Some(self.update_predicted(&prior, z)?),
             None => None,
         };
         Ok(Step { prior, update })
@@ -213,7 +226,9 @@ where
             let (pred, cross) = self.prediction_with_cross_covariance(&filtered[k])?;
             let chol = cholesky(pred.covariance.clone(), "P(k+1|k)")?;
             // G^T = P(k+1|k)^-1 C^T, since P(k+1|k) is symmetric
-            let gain = chol.solve(&cross.transpose()).transpose();
+            let mut gt = cross.transpose();
+            chol.solve_mut(&mut gt);
+            let gain = gt.transpose();
             let next = &out[k + 1];
             let dx = &next.mean - &pred.mean;
             let dp = &next.covariance - &pred.covariance;
@@ -243,6 +258,7 @@ where
 }
 
 /// The prediction of a linearised model: mean given, `P' = F P F^T + Q`, symmetrised.
+#[inline(always)]
 pub(crate) fn linearized_predict<T, D>(
     mean: OVector<T, D>,
     f: &OMatrix<T, D, D>,
@@ -269,6 +285,7 @@ where
 
 /// The update of a linearised observation model: `S = H P H^T + R`, `K = P H^T S^-1` by a
 /// Cholesky solve, `x + K y`, covariance by `form`, log-likelihood from the same factor.
+#[inline(always)]
 pub(crate) fn linearized_update<T, D, M, Ob>(
     observation: &Ob,
     prior: &Gaussian<T, D>,
@@ -303,7 +320,9 @@ where
     symmetrise(&mut s);
     let chol = cholesky(s.clone(), "S")?;
     // K^T = S^-1 H P (P symmetric)
-    let gain = chol.solve(&hp).transpose();
+    let mut kt = hp.clone();
+    chol.solve_mut(&mut kt);
+    let gain = kt.transpose();
     let y = observation.observation_residual(z, predicted_z);
     let mean = &prior.mean + &gain * &y;
     let mut cov = match form {
@@ -343,17 +362,20 @@ where
 }
 
 /// `ln N(y; 0, S)` from the Cholesky factor of `S`.
-pub(crate) fn gaussian_log_likelihood<T, M>(chol: &nalgebra::Cholesky<T, M>, y: &OVector<T, M>) -> T
+#[inline(always)]
+pub(crate) fn gaussian_log_likelihood<T, M>(chol: &Chol<T, M>, y: &OVector<T, M>) -> T
 where
     T: RealField + Copy,
     M: Dim,
     DefaultAllocator: Allocator<M> + Allocator<M, M>,
 {
     let mut w = y.clone();
-    chol.l_dirty().solve_lower_triangular_unchecked_mut(&mut w);
+    chol.solve_lower_mut(&mut w);
     let m = nalgebra::convert::<f64, T>(y.nrows() as f64);
     let half = nalgebra::convert::<f64, T>(0.5);
-    -half * (m * T::two_pi().ln() + log_det(chol) + w.norm_squared())
+    // ln(2 pi)
+    let ln_two_pi = nalgebra::convert::<f64, T>(1.837_877_066_409_345_5);
+    -half * (m * ln_two_pi + chol.log_det() + w.norm_squared())
 }
 
 /// Validates a state against the transition's dimension (shared by every filter's steps).

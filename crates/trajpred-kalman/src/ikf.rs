@@ -247,7 +247,9 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
         let p = &prior.covariance;
         let hp = h * p;
         let chol = cholesky(previous.covariance.clone(), "S")?;
-        let gain = chol.solve(&hp).transpose();
+        let mut kt = hp.clone();
+        chol.solve_mut(&mut kt);
+        let gain = kt.transpose();
         let mean = &prior.mean + &gain * &previous.residual;
         let mut cov = match self.covariance_update {
             CovarianceUpdate::Joseph => {

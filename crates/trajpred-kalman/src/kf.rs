@@ -104,6 +104,7 @@ where
         + Allocator<D, M>
         + Allocator<M, D>,
 {
+    #[inline(always)]
     fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
         validate_state(state, self.transition.state_dim())?;
         let f = self.transition.transition_matrix();
@@ -113,6 +114,16 @@ where
 
     fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>> {
         validate_state(prior, self.transition.state_dim())?;
+        self.update_predicted(prior, z)
+    }
+
+    #[inline(always)]
+    fn update_predicted(
+        &self,
+        prior: &Gaussian<T, D>,
+        z: &OVector<T, M>,
+    ) -> Result<Update<T, D, M>> {
+        check_dim("prior", self.transition.state_dim(), prior.mean.nrows())?;
         let h = self.observation.observation_matrix();
         let zp = h * &prior.mean;
         linearized_update(&self.observation, prior, &zp, h, z, self.covariance_update)
@@ -218,6 +229,16 @@ where
 
     fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>> {
         validate_state(prior, self.transition.state_dim())?;
+        self.update_predicted(prior, z)
+    }
+
+    #[inline(always)]
+    fn update_predicted(
+        &self,
+        prior: &Gaussian<T, D>,
+        z: &OVector<T, M>,
+    ) -> Result<Update<T, D, M>> {
+        check_dim("prior", self.transition.state_dim(), prior.mean.nrows())?;
         let zp = self.observation.observe(&prior.mean)?;
         let h = self.observation.observation_jacobian(&prior.mean)?;
         linearized_update(&self.observation, prior, &zp, &h, z, self.covariance_update)

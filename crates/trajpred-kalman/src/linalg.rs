@@ -3,10 +3,11 @@
 
 use crate::error::{KalmanError, Result};
 use nalgebra::allocator::Allocator;
-use nalgebra::{Cholesky, DefaultAllocator, Dim, Matrix, OMatrix, RealField, Storage};
+use nalgebra::{DefaultAllocator, Dim, Matrix, OMatrix, RealField, Storage};
 use trajpred_core::Gaussian;
 
 /// Errors with [`KalmanError::NonFinite`] if any element of `m` is NaN or infinite.
+#[inline(always)]
 pub(crate) fn check_finite<T, R, C, S>(m: &Matrix<T, R, C, S>, what: &'static str) -> Result<()>
 where
     T: RealField + Copy,
@@ -21,6 +22,7 @@ where
 }
 
 /// Errors with [`KalmanError::DimensionMismatch`] unless `got == expected`.
+#[inline(always)]
 pub(crate) fn check_dim(what: &'static str, expected: usize, got: usize) -> Result<()> {
     if expected == got {
         Ok(())
@@ -34,6 +36,7 @@ pub(crate) fn check_dim(what: &'static str, expected: usize, got: usize) -> Resu
 }
 
 /// Checks that `m` is `n x n`.
+#[inline(always)]
 pub(crate) fn check_square<T, R, C, S>(
     m: &Matrix<T, R, C, S>,
     n: usize,
@@ -49,15 +52,123 @@ where
     check_dim(what, n, m.ncols())
 }
 
+/// The lower Cholesky factor `L` (`A = L L^T`) of a symmetric positive definite matrix,
+/// computed in place by a plain Cholesky-Banachiewicz loop (faster than the general
+/// factorisation for the 2x2 to 6x6 matrices of tracking filters; reads only the lower
+/// triangle).
+#[derive(Debug, Clone)]
+pub(crate) struct Chol<T: RealField, D: Dim>
+where
+    DefaultAllocator: Allocator<D, D>,
+{
+    l: OMatrix<T, D, D>,
+}
+
+impl<T: RealField + Copy, D: Dim> Chol<T, D>
+where
+    DefaultAllocator: Allocator<D, D>,
+{
+    /// Factorises `a`, or `None` if a pivot is not strictly positive (or not finite).
+    #[inline(always)]
+    pub(crate) fn new(mut a: OMatrix<T, D, D>) -> Option<Self> {
+        let n = a.nrows();
+        for j in 0..n {
+            let mut d = a[(j, j)];
+            for k in 0..j {
+                d -= a[(j, k)] * a[(j, k)];
+            }
+            if !(d > T::zero()) || !d.is_finite() {
+                return None;
+            }
+            let ljj = d.sqrt();
+            a[(j, j)] = ljj;
+            for i in (j + 1)..n {
+                let mut s = a[(i, j)];
+                for k in 0..j {
+                    s -= a[(i, k)] * a[(j, k)];
+                }
+                a[(i, j)] = s / ljj;
+            }
+            for i in 0..j {
+                a[(i, j)] = T::zero();
+            }
+        }
+        Some(Chol { l: a })
+    }
+
+    /// The factor `L`, by value.
+    pub(crate) fn unpack(self) -> OMatrix<T, D, D> {
+        self.l
+    }
+
+    /// Solves `L w = b` in place, column by column.
+    #[inline(always)]
+    pub(crate) fn solve_lower_mut<C: Dim>(&self, b: &mut OMatrix<T, D, C>)
+    where
+        DefaultAllocator: Allocator<D, C>,
+    {
+        let n = self.l.nrows();
+        for c in 0..b.ncols() {
+            for i in 0..n {
+                let mut s = b[(i, c)];
+                for k in 0..i {
+                    s -= self.l[(i, k)] * b[(k, c)];
+                }
+                b[(i, c)] = s / self.l[(i, i)];
+            }
+        }
+    }
+
+    /// Solves `A x = b` (`A = L L^T`) in place.
+    #[inline(always)]
+    pub(crate) fn solve_mut<C: Dim>(&self, b: &mut OMatrix<T, D, C>)
+    where
+        DefaultAllocator: Allocator<D, C>,
+    {
+        self.solve_lower_mut(b);
+        let n = self.l.nrows();
+        for c in 0..b.ncols() {
+            for i in (0..n).rev() {
+                let mut s = b[(i, c)];
+                for k in (i + 1)..n {
+                    s -= self.l[(k, i)] * b[(k, c)];
+                }
+                b[(i, c)] = s / self.l[(i, i)];
+            }
+        }
+    }
+
+    /// `ln det A = 2 sum ln L_ii` (one logarithm of the product when it is representable).
+    #[inline(always)]
+    pub(crate) fn log_det(&self) -> T {
+        let n = self.l.nrows();
+        let mut prod = T::one();
+        for i in 0..n {
+            prod *= self.l[(i, i)];
+        }
+        let two = T::one() + T::one();
+        if prod > T::zero() && prod.is_finite() && prod > T::min_value().unwrap_or(T::zero()) {
+            two * prod.ln()
+        } else {
+            let mut s = T::zero();
+            for i in 0..n {
+                s += self.l[(i, i)].ln();
+            }
+            two * s
+        }
+    }
+}
+
 /// Cholesky factor of a symmetric positive definite matrix, or
 /// [`KalmanError::NotPositiveDefinite`] naming `what`.
-pub(crate) fn cholesky<T, D>(m: OMatrix<T, D, D>, what: &'static str) -> Result<Cholesky<T, D>>
+#[inline(always)]
+pub(crate) fn cholesky<T, D>(m: OMatrix<T, D, D>, what: &'static str) -> Result<Chol<T, D>>
 where
     T: RealField + Copy,
     D: Dim,
     DefaultAllocator: Allocator<D, D>,
 {
-    Cholesky::new(m).ok_or(KalmanError::NotPositiveDefinite { what })
+    Chol::new(m).ok_or(KalmanError::NotPositiveDefinite { what })
 }
 
 /// Symmetry tolerance: `sqrt(eps)` relative to the largest magnitude (at least 1).
@@ -69,6 +180,7 @@ fn symmetry_tolerance<T: RealField + Copy>(scale: T) -> T {
 /// semi-definite: the Cholesky factorisation of `m + 64 n eps max|m| I` must exist, which
 /// accepts rank-deficient matrices such as the discrete white-noise `Q` while rejecting any
 /// eigenvalue below about `-64 n eps max|m|`.
+#[inline(always)]
 pub(crate) fn check_psd<T, D>(m: &OMatrix<T, D, D>, what: &'static str) -> Result<()>
 where
     T: RealField + Copy,
@@ -101,6 +213,7 @@ where
 }
 
 /// Checks that `m` is symmetric positive definite (its Cholesky factor exists).
+#[inline(always)]
 pub(crate) fn check_pd<T, D>(m: &OMatrix<T, D, D>, what: &'static str) -> Result<()>
 where
     T: RealField + Copy,
@@ -122,6 +235,7 @@ where
 
 /// Validates a Gaussian state of dimension `n`: shapes, finite values, and a symmetric
 /// positive semi-definite covariance (see [`check_psd`]).
+#[inline(always)]
 pub(crate) fn check_state<T, D>(state: &Gaussian<T, D>, n: usize) -> Result<()>
 where
     T: RealField + Copy,
@@ -135,6 +249,7 @@ where
 }
 
 /// Replaces `m` by its symmetric part `(m + m^T) / 2` in place.
+#[inline(always)]
 pub(crate) fn symmetrise<T, D>(m: &mut OMatrix<T, D, D>)
 where
     T: RealField + Copy,
@@ -150,19 +265,4 @@ where
             m[(j, i)] = v;
         }
     }
-}
-
-/// `ln det A` from the Cholesky factor of `A`.
-pub(crate) fn log_det<T, D>(chol: &Cholesky<T, D>) -> T
-where
-    T: RealField + Copy,
-    D: Dim,
-    DefaultAllocator: Allocator<D, D>,
-{
-    let l = chol.l_dirty();
-    let mut s = T::zero();
-    for i in 0..l.nrows() {
-        s += l[(i, i)].ln();
-    }
-    s + s
 }

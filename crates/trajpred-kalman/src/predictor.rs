@@ -73,7 +73,9 @@ impl<Tr, Ob> Kf<Tr, Ob> {
         let chol = cholesky(s, "S")?;
         // H P A^T (m x n); K = A P H^T S^-1 = (S^-1 H P A^T)^T
         let hpa = &hp * a.transpose();
-        let gain = chol.solve(&hpa).transpose();
+        let mut kt = hpa.clone();
+        chol.solve_mut(&mut kt);
+        let gain = kt.transpose();
         let innovation = z - h * &prediction.mean;
         let mean = a * &prediction.mean + &gain * innovation;
         let mut cov = a * p * a.transpose() - &gain * &hpa + tr.process_noise();

@@ -306,8 +306,16 @@ where
     }
 
     fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>> {
-        let n = self.transition.state_dim();
-        validate_state(prior, n)?;
+        validate_state(prior, self.transition.state_dim())?;
+        self.update_predicted(prior, z)
+    }
+
+    fn update_predicted(
+        &self,
+        prior: &Gaussian<T, D>,
+        z: &OVector<T, M>,
+    ) -> Result<Update<T, D, M>> {
+        check_dim("prior", self.transition.state_dim(), prior.mean.nrows())?;
         let m = self.observation.observation_dim();
         check_dim("observation", m, z.nrows())?;
         check_finite(z, "observation")?;
@@ -323,7 +331,9 @@ where
         let mut s = t.covariance + ob.observation_noise();
         symmetrise(&mut s);
         let chol = cholesky(s.clone(), "S")?;
-        let gain = chol.solve(&t.cross.transpose()).transpose();
+        let mut kt = t.cross.transpose();
+        chol.solve_mut(&mut kt);
+        let gain = kt.transpose();
         let y = ob.observation_residual(z, &z_hat);
         let mean = &prior.mean + &gain * &y;
         let mut cov = &prior.covariance - &gain * &s * gain.transpose();
