@@ -77,7 +77,7 @@ where
             for k in 0..j {
                 d -= a[(j, k)] * a[(j, k)];
             }
-            if !(d > T::zero()) || !d.is_finite() {
+            if d <= T::zero() || !d.is_finite() {
                 return None;
             }
             let ljj = d.sqrt();
