@@ -22,3 +22,4 @@ pub mod ikf;
 pub mod predictor;
 pub use ikf::{Ikf, IkfStep, Innovation};
 pub use predictor::MultiStep;
+pub mod sampling;

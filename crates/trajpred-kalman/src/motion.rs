@@ -236,7 +236,7 @@ where
 /// ```
 ///
 /// with the limits `sin(wT)/w -> T`, `(1 - cos(wT))/w -> 0` as `w -> 0` (a series is used for
-/// `|w T| < 1e-4`, so the model and its Jacobian are smooth through straight flight).
+/// `|w T| < 1e-2`, so the model and its Jacobian are smooth through straight flight).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CoordinatedTurn<T: RealField> {
     dt: T,
@@ -278,26 +278,36 @@ impl<T: RealField + Copy> CoordinatedTurn<T> {
     fn coefficients(&self, w: T) -> [T; 6] {
         let t = self.dt;
         let wt = w * t;
-        let (s, c) = (wt.sin(), wt.cos());
+        let (s, c) = wt.sin_cos();
         let k = |v: f64| nalgebra::convert::<f64, T>(v);
-        if wt.abs() < k(1e-4) {
-            let (t2, t3, t4) = (t * t, t * t * t, t * t * t * t);
-            let w2 = w * w;
+        if wt.abs() < k(1e-2) {
+            // Taylor series in x = wT (truncation below 1e-20 relative for |x| < 1e-2);
+            // the closed forms lose about eps / x^2 to cancellation there.
+            let x = wt;
+            let x2 = x * x;
+            let t2 = t * t;
             [
-                t - w2 * t3 / k(6.0),
-                w * t2 / k(2.0) - w2 * w * t4 / k(24.0),
-                -w * t3 / k(3.0),
-                t2 / k(2.0) - w2 * t4 / k(8.0),
+                t * (T::one()
+                    - x2 / k(6.0) * (T::one() - x2 / k(20.0) * (T::one() - x2 / k(42.0)))),
+                t * x
+                    * (k(0.5)
+                        - x2 / k(24.0) * (T::one() - x2 / k(30.0) * (T::one() - x2 / k(56.0)))),
+                t2 * x * (-T::one() / k(3.0) + x2 / k(30.0) - x2 * x2 / k(840.0)),
+                t2 * (k(0.5) - x2 / k(8.0) + x2 * x2 / k(144.0) - x2 * x2 * x2 / k(5760.0)),
                 c,
                 s,
             ]
         } else {
             let w2 = w * w;
+            let half = wt * k(0.5);
+            let sh = half.sin();
+            // 1 - cos(wT) = 2 sin^2(wT / 2), free of cancellation
+            let one_minus_c = k(2.0) * sh * sh;
             [
                 s / w,
-                (T::one() - c) / w,
+                one_minus_c / w,
                 (wt * c - s) / w2,
-                (wt * s - T::one() + c) / w2,
+                (wt * s - one_minus_c) / w2,
                 c,
                 s,
             ]

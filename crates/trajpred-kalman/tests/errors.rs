@@ -1,0 +1,301 @@
+//! Bad input: every variant of `KalmanError` is reached, and nothing panics or returns NaN.
+
+use nalgebra::{
+    DMatrix, DVector, Matrix1, Matrix1x2, Matrix2, Matrix4, U2, U4, U5, Vector1, Vector2, Vector4,
+    Vector5,
+};
+use trajpred_core::Gaussian;
+use trajpred_kalman::motion::{
+    KinematicLayout, StateOrder, constant_velocity, position_observation,
+};
+use trajpred_kalman::{
+    CoordinatedTurn, Ekf, Filter, Ikf, Innovation, KalmanError, Kf, LinearObservation,
+    LinearTransition, MerweSigmaPoints, RangeBearing, Smoother, Ukf,
+};
+
+fn cv() -> (LinearTransition<f64, U4>, LinearObservation<f64, U4, U2>) {
+    let tr = constant_velocity(2, 0.5, 1.0, StateOrder::AxisBlocks).unwrap();
+    let layout = KinematicLayout::new(2, 2, StateOrder::AxisBlocks).unwrap();
+    (tr, position_observation(layout, 0.5).unwrap())
+}
+
+fn state() -> Gaussian<f64, U4> {
+    Gaussian {
+        mean: Vector4::new(1.0, 0.0, 2.0, 0.0),
+        covariance: Matrix4::identity(),
+    }
+}
+
+#[test]
+fn dimension_mismatches() {
+    // run-time sizes: an observation of the wrong length
+    let tr =
+        LinearTransition::new(DMatrix::<f64>::identity(3, 3), DMatrix::identity(3, 3)).unwrap();
+    let ob =
+        LinearObservation::new(DMatrix::<f64>::identity(2, 3), DMatrix::identity(2, 2)).unwrap();
+    let kf = Kf::new(&tr, &ob).unwrap();
+    let x = Gaussian {
+        mean: DVector::zeros(3),
+        covariance: DMatrix::identity(3, 3),
+    };
+    let r = kf.step(&x, Some(&DVector::zeros(3)));
+    assert!(matches!(
+        r,
+        Err(KalmanError::DimensionMismatch {
+            expected: 2,
+            got: 3,
+            ..
+        })
+    ));
+    // a state of the wrong size
+    let x4 = Gaussian {
+        mean: DVector::zeros(4),
+        covariance: DMatrix::identity(4, 4),
+    };
+    assert!(matches!(
+        kf.predict(&x4),
+        Err(KalmanError::DimensionMismatch { .. })
+    ));
+    // F and Q of different sizes; H with the wrong number of columns
+    assert!(matches!(
+        LinearTransition::new(DMatrix::<f64>::identity(3, 3), DMatrix::identity(2, 2)),
+        Err(KalmanError::DimensionMismatch { .. })
+    ));
+    let bad_h =
+        LinearObservation::new(DMatrix::<f64>::identity(2, 4), DMatrix::identity(2, 2)).unwrap();
+    assert!(matches!(
+        Kf::new(&tr, &bad_h),
+        Err(KalmanError::DimensionMismatch { .. })
+    ));
+    // a static size that does not fit the number of axes
+    assert!(matches!(
+        constant_velocity::<f64, U5>(2, 1.0, 1.0, StateOrder::AxisBlocks),
+        Err(KalmanError::DimensionMismatch {
+            expected: 4,
+            got: 5,
+            ..
+        })
+    ));
+    // an innovation whose S does not match its residual
+    assert!(matches!(
+        Innovation::new(DVector::<f64>::zeros(2), DMatrix::identity(3, 3)),
+        Err(KalmanError::DimensionMismatch { .. })
+    ));
+    // range-bearing indices beyond the state
+    let rb = RangeBearing::new(Vector2::new(0.0, 0.0), 0, 7, 1.0, 0.1).unwrap();
+    let ekf = Ekf::new(&tr, &rb);
+    assert!(
+        ekf.is_err() || {
+            let e = ekf.unwrap();
+            matches!(
+                e.update(&x, &Vector2::zeros()),
+                Err(KalmanError::DimensionMismatch { .. })
+            )
+        }
+    );
+}
+
+#[test]
+fn non_finite_inputs() {
+    let (tr, ob) = cv();
+    let kf = Kf::new(&tr, &ob).unwrap();
+    let r = kf.step(&state(), Some(&Vector2::new(f64::NAN, 0.0)));
+    assert!(matches!(
+        r,
+        Err(KalmanError::NonFinite {
+            what: "observation",
+            index: 0
+        })
+    ));
+    let mut s = state();
+    s.mean[2] = f64::INFINITY;
+    assert!(matches!(
+        kf.predict(&s),
+        Err(KalmanError::NonFinite { index: 2, .. })
+    ));
+    let mut f = Matrix4::identity();
+    f[(1, 1)] = f64::NAN;
+    assert!(matches!(
+        LinearTransition::new(f, Matrix4::identity()),
+        Err(KalmanError::NonFinite { what: "F", .. })
+    ));
+    // overflow inside the filter is reported, never returned as inf/NaN
+    let huge = Gaussian {
+        mean: Vector4::new(1.7e308, 1.7e308, 0.0, 0.0),
+        covariance: Matrix4::identity() * 1.7e308,
+    };
+    let r = kf.predict(&huge);
+    assert!(matches!(r, Err(KalmanError::NonFinite { .. })), "{r:?}");
+    let ukf = Ukf::new(&tr, &ob, MerweSigmaPoints::new(0.5, 2.0, 0.0)).unwrap();
+    assert!(matches!(
+        ukf.update(&state(), &Vector2::new(0.0, f64::NEG_INFINITY)),
+        Err(KalmanError::NonFinite { .. })
+    ));
+}
+
+#[test]
+fn not_positive_definite_p_q_r_s() {
+    let (tr, ob) = cv();
+    let kf = Kf::new(&tr, &ob).unwrap();
+    // P indefinite (an eigenvalue of -1): rejected by every filter
+    let mut bad = state();
+    bad.covariance = Matrix4::from_diagonal(&Vector4::new(1.0, -1.0, 1.0, 1.0));
+    assert!(matches!(
+        kf.predict(&bad),
+        Err(KalmanError::NotPositiveDefinite { what: "P" })
+    ));
+    assert!(matches!(
+        kf.update(&bad, &Vector2::new(0.0, 0.0)),
+        Err(KalmanError::NotPositiveDefinite { what: "P" })
+    ));
+    // P with positive diagonal but indefinite (off-diagonal too large)
+    bad.covariance = Matrix4::identity();
+    bad.covariance[(0, 1)] = 2.0;
+    bad.covariance[(1, 0)] = 2.0;
+    let ukf = Ukf::new(&tr, &ob, MerweSigmaPoints::default()).unwrap();
+    assert!(matches!(
+        ukf.predict(&bad),
+        Err(KalmanError::NotPositiveDefinite { what: "P" })
+    ));
+    // P not symmetric
+    bad.covariance = Matrix4::identity();
+    bad.covariance[(0, 1)] = 0.5;
+    let ekf = Ekf::new(&tr, &ob).unwrap();
+    assert!(matches!(
+        ekf.predict(&bad),
+        Err(KalmanError::NotPositiveDefinite { what: "P" })
+    ));
+    // Q indefinite
+    assert!(matches!(
+        LinearTransition::new(Matrix2::identity(), Matrix2::new(1.0, 0.0, 0.0, -0.5)),
+        Err(KalmanError::NotPositiveDefinite { what: "Q" })
+    ));
+    // R singular (positive semi-definite is not enough for R)
+    assert!(matches!(
+        LinearObservation::new(Matrix1x2::new(1.0, 0.0), Matrix1::new(0.0)),
+        Err(KalmanError::NotPositiveDefinite { what: "R" })
+    ));
+    // S: an innovation covariance that is not positive definite
+    assert!(matches!(
+        Innovation::new(Vector1::new(1.0), Matrix1::new(-1.0)),
+        Err(KalmanError::NotPositiveDefinite { what: "S" })
+    ));
+    // the UKF needs a strictly positive definite P for its sigma points
+    let mut singular = state();
+    singular.covariance[(3, 3)] = 0.0;
+    assert!(matches!(
+        ukf.predict(&singular),
+        Err(KalmanError::NotPositiveDefinite { what: "P" })
+    ));
+    // ... while the KF accepts a positive semi-definite P (a known component)
+    assert!(kf.predict(&singular).is_ok());
+}
+
+#[test]
+fn s_not_positive_definite_inside_an_update() {
+    // A user observation model whose R is validated but whose Jacobian returns NaN-free
+    // values that overflow S: S = H P H^T + R is then not finite -> not positive definite.
+    let (tr, _) = cv();
+    let h = Matrix1x2::new(1e200, 0.0);
+    let tr1 = LinearTransition::new(Matrix2::<f64>::identity(), Matrix2::identity()).unwrap();
+    let ob = LinearObservation::new(h, Matrix1::new(1.0)).unwrap();
+    let kf = Kf::new(&tr1, &ob).unwrap();
+    let x = Gaussian {
+        mean: Vector2::new(0.0, 0.0),
+        covariance: Matrix2::identity() * 1e200,
+    };
+    let r = kf.update(&x, &Vector1::new(0.0));
+    assert!(
+        matches!(r, Err(KalmanError::NotPositiveDefinite { what: "S" })),
+        "{r:?}"
+    );
+    let _ = tr;
+}
+
+#[test]
+fn invalid_parameters() {
+    assert!(matches!(
+        constant_velocity::<f64, U4>(2, 0.0, 1.0, StateOrder::AxisBlocks),
+        Err(KalmanError::InvalidParameter { name: "dt", .. })
+    ));
+    assert!(matches!(
+        constant_velocity::<f64, nalgebra::Dyn>(4, 1.0, 1.0, StateOrder::AxisBlocks),
+        Err(KalmanError::InvalidParameter { name: "axes", .. })
+    ));
+    assert!(matches!(
+        CoordinatedTurn::<f64>::new(1.0, -1.0, 0.1),
+        Err(KalmanError::InvalidParameter {
+            name: "accel_var",
+            ..
+        })
+    ));
+    assert!(matches!(
+        RangeBearing::<f64>::new(Vector2::zeros(), 0, 1, 0.0, 0.1),
+        Err(KalmanError::InvalidParameter {
+            name: "range_var",
+            ..
+        })
+    ));
+    assert!(matches!(
+        MerweSigmaPoints::<f64>::default().weights(0),
+        Err(KalmanError::InvalidParameter { name: "n", .. })
+    ));
+}
+
+#[test]
+fn degenerate_sigma_point_weights() {
+    let (tr, ob) = cv();
+    // kappa = -n: n + lambda = alpha^2 (n + kappa) = 0, weights 1 / (2 (n + lambda)) infinite
+    let r = Ukf::new(&tr, &ob, MerweSigmaPoints::new(1.0, 2.0, -4.0));
+    assert!(matches!(
+        r,
+        Err(KalmanError::DegenerateSigmaPoints { n: 4, .. })
+    ));
+    // kappa < -n: negative weights
+    let r = Ukf::new(&tr, &ob, MerweSigmaPoints::new(0.5, 2.0, -5.0));
+    assert!(matches!(r, Err(KalmanError::DegenerateSigmaPoints { .. })));
+    // alpha = 0 and non-finite parameters
+    for p in [
+        MerweSigmaPoints::new(0.0, 2.0, 0.0),
+        MerweSigmaPoints::new(f64::NAN, 2.0, 0.0),
+        MerweSigmaPoints::new(1.0, f64::INFINITY, 0.0),
+    ] {
+        assert!(matches!(
+            Ukf::new(&tr, &ob, p),
+            Err(KalmanError::DegenerateSigmaPoints { .. })
+        ));
+    }
+}
+
+#[test]
+fn undefined_model_and_empty_input() {
+    // an EKF update of a target exactly at the sensor: the bearing Jacobian is undefined
+    let ct = CoordinatedTurn::new(1.0, 0.1, 0.01).unwrap();
+    let rb = RangeBearing::new(Vector2::new(3.0, 4.0), 0, 2, 1.0, 0.01).unwrap();
+    let ekf = Ekf::new(&ct, &rb).unwrap();
+    let at_sensor = Gaussian {
+        mean: Vector5::new(3.0, 0.0, 4.0, 0.0, 0.0),
+        covariance: nalgebra::Matrix5::identity(),
+    };
+    let r = ekf.update(&at_sensor, &Vector2::new(1.0, 0.0));
+    assert!(matches!(r, Err(KalmanError::Undefined { .. })), "{r:?}");
+    // smoothing nothing
+    let (tr, ob) = cv();
+    let kf = Kf::new(&tr, &ob).unwrap();
+    assert!(matches!(kf.smooth(&[]), Err(KalmanError::Empty { .. })));
+    // an empty sequence filters to nothing (not an error)
+    assert!(kf.filter(&state(), &[]).unwrap().is_empty());
+    // the IKF reports the same checks
+    let ikf = Ikf::new(&tr, &ob).unwrap();
+    assert!(matches!(
+        ikf.innovation(&state(), &Vector2::new(f64::NAN, 1.0)),
+        Err(KalmanError::NonFinite { .. })
+    ));
+    let _ = U5;
+}
+
+#[test]
+fn errors_convert_into_the_core_error() {
+    let e: trajpred_core::Error = KalmanError::Empty { what: "x" }.into();
+    assert!(e.to_string().contains("trajpred-kalman"));
+}
