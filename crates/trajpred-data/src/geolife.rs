@@ -24,7 +24,7 @@ use crate::geodesy::FOOT;
 use crate::io::{for_each_line, list, open, stem};
 use crate::report::LoadReport;
 use crate::time::{parse_date_time, parse_datetime};
-use crate::track::{Cleaner, FrameKind, LoadOptions, RawPoint, Track, num};
+use crate::track::{Cleaner, FrameKind, LoadOptions, RawPoint, Track, fields, num};
 use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
@@ -56,7 +56,7 @@ pub fn parse_plt<R: BufRead>(
             c.report.records_read += 1;
             return c.malformed(line, "invalid UTF-8");
         };
-        if text.trim().is_empty() {
+        if text.trim_ascii().is_empty() {
             c.report.blank_lines += 1;
             return Ok(());
         }
@@ -77,10 +77,7 @@ pub fn parse_plt<R: BufRead>(
 }
 
 fn parse_plt_line(text: &str, line: usize) -> std::result::Result<RawPoint, String> {
-    let f: Vec<&str> = text.split(',').collect();
-    if f.len() != 7 {
-        return Err(format!("expected 7 fields, got {}", f.len()));
-    }
+    let f: [&str; 7] = fields(text, b',').map_err(|n| format!("expected 7 fields, got {n}"))?;
     let lat = num(f[0]).ok_or_else(|| format!("latitude {:?} is not a number", f[0]))?;
     let lon = num(f[1]).ok_or_else(|| format!("longitude {:?} is not a number", f[1]))?;
     let alt_ft = num(f[3]).ok_or_else(|| format!("altitude {:?} is not a number", f[3]))?;
@@ -194,7 +191,7 @@ pub fn parse_labels<R: BufRead>(
             c.report.records_read += 1;
             return c.malformed(line, "invalid UTF-8");
         };
-        if text.trim().is_empty() {
+        if text.trim_ascii().is_empty() {
             c.report.blank_lines += 1;
             return Ok(());
         }

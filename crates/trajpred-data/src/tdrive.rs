@@ -23,7 +23,7 @@ use crate::error::Result;
 use crate::io::{for_each_line, list, open, stem};
 use crate::report::{LoadReport, SkipReason};
 use crate::time::parse_datetime;
-use crate::track::{Cleaner, FrameKind, LoadOptions, RawPoint, Track, num};
+use crate::track::{Cleaner, FrameKind, LoadOptions, RawPoint, Track, fields, num};
 use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
@@ -40,29 +40,33 @@ pub fn parse<R: BufRead>(
     report.groups += 1;
     let mut points = Vec::new();
     let mut taxi: Option<String> = None;
-    let mut previous: Option<String> = None;
+    // the previous line, for the duplicate check (`None` after an undecodable line)
+    let mut previous = String::new();
+    let mut have_previous = false;
     let mut c = Cleaner { opts, file, report };
     for_each_line(reader, file, |line, text| {
         let Some(text) = text else {
             c.report.records_read += 1;
-            previous = None;
+            have_previous = false;
             return c.malformed(line, "invalid UTF-8");
         };
-        if text.trim().is_empty() {
+        if text.trim_ascii().is_empty() {
             c.report.blank_lines += 1;
             return Ok(());
         }
         c.report.records_read += 1;
-        if previous.as_deref() == Some(text) {
+        if have_previous && previous == text {
             c.report.skip(file, line, SkipReason::DuplicateLine, "");
             return Ok(());
         }
-        previous = Some(text.to_string());
-        let f: Vec<&str> = text.split(',').collect();
-        if f.len() != 4 {
-            return c.malformed(line, format!("expected 4 fields, got {}", f.len()));
-        }
-        let id = f[0].trim();
+        previous.clear();
+        previous.push_str(text);
+        have_previous = true;
+        let f: [&str; 4] = match fields(text, b',') {
+            Ok(f) => f,
+            Err(n) => return c.malformed(line, format!("expected 4 fields, got {n}")),
+        };
+        let id = f[0].trim_ascii();
         if id.is_empty() {
             return c.malformed(line, "empty taxi id");
         }

@@ -32,9 +32,25 @@ fn digits(s: &str) -> Option<u32> {
     s.parse().ok()
 }
 
+/// Two ASCII digits at `b[i..i + 2]`.
+fn two(b: &[u8], i: usize) -> Option<u32> {
+    let (x, y) = (b[i].wrapping_sub(b'0'), b[i + 1].wrapping_sub(b'0'));
+    (x < 10 && y < 10).then_some(u32::from(x) * 10 + u32::from(y))
+}
+
 /// A date `YYYY<sep>MM<sep>DD` (sep `-` or `/`) to days since 1970-01-01, with the month and
 /// day checked against the calendar.
 pub fn parse_date(s: &str) -> Option<i64> {
+    // fast path for the zero-padded form of every format here (it matters in debug builds)
+    let b = s.as_bytes();
+    if b.len() == 10 && (b[4] == b'-' || b[4] == b'/') && b[7] == b[4] {
+        let (y, m, d) = (two(b, 0)? * 100 + two(b, 2)?, two(b, 5)?, two(b, 8)?);
+        let y = i64::from(y);
+        if !(1..=12).contains(&m) || d == 0 || d > days_in_month(y, m) {
+            return None;
+        }
+        return Some(days_from_civil(y, m, d));
+    }
     let mut it = s.trim().split(['-', '/']);
     let (y, m, d) = (it.next()?, it.next()?, it.next()?);
     if it.next().is_some() || y.len() != 4 {
@@ -49,6 +65,14 @@ pub fn parse_date(s: &str) -> Option<i64> {
 
 /// A time of day `HH:MM:SS` (seconds may carry a fraction) to seconds since midnight.
 pub fn parse_time(s: &str) -> Option<f64> {
+    let b = s.as_bytes();
+    if b.len() == 8 && b[2] == b':' && b[5] == b':' {
+        let (h, m, sec) = (two(b, 0)?, two(b, 3)?, two(b, 6)?);
+        if h > 23 || m > 59 || sec > 59 {
+            return None;
+        }
+        return Some(f64::from(h * 3600 + m * 60 + sec));
+    }
     let mut it = s.trim().split(':');
     let (h, m, sec) = (it.next()?, it.next()?, it.next()?);
     if it.next().is_some() {
@@ -76,7 +100,11 @@ pub fn parse_date_time(date: &str, time: &str) -> Option<f64> {
 
 /// `YYYY-MM-DD HH:MM:SS` (one space, or a `T`) to seconds since the Unix epoch.
 pub fn parse_datetime(s: &str) -> Option<f64> {
-    let s = s.trim();
+    let s = s.trim_ascii();
+    let b = s.as_bytes();
+    if b.len() == 19 && (b[10] == b' ' || b[10] == b'T') {
+        return parse_date_time(&s[..10], &s[11..]);
+    }
     let (d, t) = s.split_once([' ', 'T'])?;
     parse_date_time(d, t)
 }

@@ -411,5 +411,25 @@ pub(crate) enum FrameKind {
 
 /// Parses a finite `f64` field.
 pub(crate) fn num(s: &str) -> Option<f64> {
-    s.trim().parse::<f64>().ok().filter(|v| v.is_finite())
+    s.trim_ascii().parse::<f64>().ok().filter(|v| v.is_finite())
+}
+
+/// Splits `text` at `sep` into exactly `N` fields, or returns the number of fields found.
+/// A plain byte loop: the generic `str::split` is slow in unoptimised (test) builds.
+pub(crate) fn fields<const N: usize>(text: &str, sep: u8) -> Result<[&str; N], usize> {
+    let b = text.as_bytes();
+    let mut out = [""; N];
+    let mut count = 0;
+    let mut start = 0;
+    for i in 0..=b.len() {
+        if i == b.len() || b[i] == sep {
+            if count < N {
+                // `sep` is ASCII, so `start..i` lies on character boundaries
+                out[count] = text.get(start..i).unwrap_or("");
+            }
+            count += 1;
+            start = i + 1;
+        }
+    }
+    if count == N { Ok(out) } else { Err(count) }
 }

@@ -192,11 +192,16 @@ fn adsb_counts_match_source_md() {
     assert_eq!(report.skipped(SkipReason::RepeatedTimestamp), 2_298);
     assert_eq!(report.skipped(SkipReason::Malformed), 0);
     assert!((max_h - 3_244_254.612_812_138).abs() < 1.0, "{max_h}");
-    // 3-D: SOURCE.md: in quickstart 50,665 points have a null altitude (and every point a
-    // position, real_data_reference.py)
-    let qs = dir.join("collections/quickstart.json.gz");
-    let (tracks, r) = adsb::load_file(&qs, &LoadOptions::adsb()).unwrap();
-    assert_eq!((r.records_read, r.groups), (284_505, 236));
-    assert_eq!(r.skipped(SkipReason::MissingValue), 50_665);
-    assert!(tracks.iter().all(|t| t.trajectory.dim() == 3));
+    // 3-D, on the two column-layout files with null altitudes (real_data_reference.py:
+    // noisy_ground 924 records, 229 null altitudes; noisy_takeoff 730 and 130)
+    for (name, records, nulls) in [
+        ("noisy/noisy_ground", 924, 229),
+        ("noisy/noisy_takeoff", 730, 130),
+    ] {
+        let f = dir.join(format!("{name}.json.gz"));
+        let (tracks, r) = adsb::load_file(&f, &LoadOptions::adsb()).unwrap();
+        assert_eq!((r.records_read, r.groups), (records, 1));
+        assert_eq!(r.skipped(SkipReason::MissingValue), nulls);
+        assert!(tracks.iter().all(|t| t.trajectory.dim() == 3));
+    }
 }
