@@ -21,8 +21,8 @@ use trajpred_kalman::motion::{
     KinematicLayout, StateOrder, constant_velocity, position_observation,
 };
 use trajpred_kalman::{
-    CoordinatedTurn, Filter, Kf, LinearObservation, LinearTransition, MerweSigmaPoints,
-    RangeBearing, Ukf,
+    CoordinatedTurn, Filter, InputChecks, Kf, LinearObservation, LinearTransition,
+    MerweSigmaPoints, RangeBearing, Ukf,
 };
 
 struct AdsTransition {
@@ -78,6 +78,7 @@ fn kf_step(c: &mut Criterion) {
         r: *ob.r(),
     };
     let kf = Kf::new(tr, ob).expect("filter");
+    let kf_cheap = kf.clone().with_input_checks(InputChecks::Cheap);
     let ads = KalmanFilterNoControl::new(&ads_tr, &ads_ob);
     let mean = Vector4::new(1.0, 0.5, -2.0, 0.3);
     let cov = Matrix4::from_diagonal(&Vector4::new(0.5, 0.2, 0.5, 0.2));
@@ -97,10 +98,39 @@ fn kf_step(c: &mut Criterion) {
             black_box(s.update.map(|u| u.posterior))
         })
     });
-    g.bench_function("trajpred_update_only_predict_update", |b| {
+    g.bench_function("trajpred_joseph_cheap_input_checks", |b| {
         b.iter(|| {
-            let prior = kf.predict(black_box(&state)).expect("predict");
-            black_box(kf.update(&prior, black_box(&z)).expect("update").posterior)
+            let s = kf_cheap
+                .step(black_box(&state), Some(black_box(&z)))
+                .expect("step");
+            black_box(s.update.map(|u| u.posterior))
+        })
+    });
+    g.bench_function("trajpred_predict_only", |b| {
+        b.iter(|| black_box(kf.predict(black_box(&state)).expect("predict")))
+    });
+    g.bench_function("trajpred_update_only", |b| {
+        b.iter(|| {
+            black_box(
+                kf.update_predicted(black_box(&state), black_box(&z))
+                    .expect("update"),
+            )
+        })
+    });
+    g.bench_function("adskalman_predict_only", |b| {
+        b.iter(|| black_box(ads_tr.predict(black_box(&ads_state))))
+    });
+    g.bench_function("adskalman_update_only", |b| {
+        b.iter(|| {
+            black_box(
+                ads_ob
+                    .update(
+                        black_box(&ads_state),
+                        black_box(&z),
+                        CovarianceUpdateMethod::JosephForm,
+                    )
+                    .expect("update"),
+            )
         })
     });
     g.bench_function("adskalman_joseph", |b| {
@@ -122,6 +152,7 @@ fn ukf_step(c: &mut Criterion) {
     let ct = CoordinatedTurn::new(0.5, 0.2, 1e-3).expect("model");
     let rb = RangeBearing::new(Vector2::new(-20.0, 15.0), 0, 2, 0.5, 1e-3).expect("model");
     let ukf = Ukf::new(ct, rb, MerweSigmaPoints::new(0.5, 2.0, -2.0)).expect("filter");
+    let ukf_cheap = ukf.clone().with_input_checks(InputChecks::Cheap);
     let state = Gaussian {
         mean: Vector5::new(0.5, 7.0, -0.5, 2.5, 0.1),
         covariance: Matrix5::from_diagonal(&Vector5::new(2.0, 1.0, 2.0, 1.0, 0.01)),
@@ -131,6 +162,14 @@ fn ukf_step(c: &mut Criterion) {
     g.bench_function("trajpred", |b| {
         b.iter(|| {
             let s = ukf
+                .step(black_box(&state), Some(black_box(&z)))
+                .expect("step");
+            black_box(s.update.map(|u| u.posterior))
+        })
+    });
+    g.bench_function("trajpred_cheap_input_checks", |b| {
+        b.iter(|| {
+            let s = ukf_cheap
                 .step(black_box(&state), Some(black_box(&z)))
                 .expect("step");
             black_box(s.update.map(|u| u.posterior))

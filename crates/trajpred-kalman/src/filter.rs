@@ -9,6 +9,19 @@ use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
 use trajpred_core::Gaussian;
 
+/// How much of the input state `predict` and `update` verify.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum InputChecks {
+    /// Shapes, finite values, symmetry, and `P` positive semi-definite (a Cholesky
+    /// factorisation of `P + 64 n eps max|P| I`). The default.
+    #[default]
+    Full,
+    /// Shapes, finite values, symmetry and a non-negative diagonal of `P`, without the
+    /// factorisation: for hot loops that feed the filter its own outputs (a particle filter,
+    /// a long batch). An indefinite `P` is then not detected at the input.
+    Cheap,
+}
+
 /// How the posterior covariance is computed from the prior `P`, the gain `K` and `H`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum CovarianceUpdate {
@@ -379,11 +392,15 @@ where
 }
 
 /// Validates a state against the transition's dimension (shared by every filter's steps).
-pub(crate) fn validate_state<T, D>(state: &Gaussian<T, D>, n: usize) -> Result<()>
+pub(crate) fn validate_state<T, D>(
+    state: &Gaussian<T, D>,
+    n: usize,
+    checks: InputChecks,
+) -> Result<()>
 where
     T: RealField + Copy,
     D: Dim,
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    check_state(state, n)
+    check_state(state, n, checks == InputChecks::Full)
 }

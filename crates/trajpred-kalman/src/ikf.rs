@@ -16,7 +16,7 @@
 //! not a filtered estimate.
 
 use crate::error::Result;
-use crate::filter::{CovarianceUpdate, validate_state};
+use crate::filter::{CovarianceUpdate, InputChecks, validate_state};
 use crate::linalg::{check_dim, check_finite, check_pd, cholesky, symmetrise};
 use crate::model::{LinearObservationModel, LinearTransitionModel, validate_models};
 use nalgebra::allocator::Allocator;
@@ -180,7 +180,7 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
             + Allocator<M, D>
             + Allocator<D, M>,
     {
-        validate_state(state, self.transition.state_dim())?;
+        validate_state(state, self.transition.state_dim(), InputChecks::Full)?;
         let covariance = self.propagate_covariance::<T, D, M>(&state.covariance)?;
         let mean = self.transition.transition_matrix() * &state.mean;
         check_finite(&mean, "predicted mean")?;
@@ -206,7 +206,7 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
             + Allocator<M, D>
             + Allocator<D, M>,
     {
-        validate_state(prior, self.transition.state_dim())?;
+        validate_state(prior, self.transition.state_dim(), InputChecks::Full)?;
         check_dim("observation", self.observation.observation_dim(), z.nrows())?;
         check_finite(z, "observation")?;
         let h = self.observation.observation_matrix();
@@ -238,7 +238,7 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
             + Allocator<D, M>,
     {
         let n = self.transition.state_dim();
-        validate_state(prior, n)?;
+        validate_state(prior, n, InputChecks::Full)?;
         let m = self.observation.observation_dim();
         check_dim("previous residual", m, previous.residual.nrows())?;
         check_dim("previous S", m, previous.covariance.nrows())?;

@@ -4,8 +4,8 @@
 
 use crate::error::Result;
 use crate::filter::{
-    CovarianceUpdate, Filter, PredictionWithCross, Smoother, Update, linearized_predict,
-    linearized_update, validate_state,
+    CovarianceUpdate, Filter, InputChecks, PredictionWithCross, Smoother, Update,
+    linearized_predict, linearized_update, validate_state,
 };
 use crate::linalg::check_dim;
 use crate::model::{
@@ -39,6 +39,7 @@ pub struct Kf<Tr, Ob> {
     transition: Tr,
     observation: Ob,
     covariance_update: CovarianceUpdate,
+    checks: InputChecks,
 }
 
 impl<Tr, Ob> Kf<Tr, Ob> {
@@ -65,12 +66,19 @@ impl<Tr, Ob> Kf<Tr, Ob> {
             transition,
             observation,
             covariance_update: CovarianceUpdate::Joseph,
+            checks: InputChecks::Full,
         })
     }
 
     /// Selects the covariance update form.
     pub fn with_covariance_update(mut self, form: CovarianceUpdate) -> Self {
         self.covariance_update = form;
+        self
+    }
+
+    /// Selects how much of the input state is verified ([`InputChecks::Full`] by default).
+    pub fn with_input_checks(mut self, checks: InputChecks) -> Self {
+        self.checks = checks;
         self
     }
 
@@ -106,14 +114,14 @@ where
 {
     #[inline(always)]
     fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
-        validate_state(state, self.transition.state_dim())?;
+        validate_state(state, self.transition.state_dim(), self.checks)?;
         let f = self.transition.transition_matrix();
         let mean = f * &state.mean;
         linearized_predict(mean, f, state, self.transition.process_noise())
     }
 
     fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>> {
-        validate_state(prior, self.transition.state_dim())?;
+        validate_state(prior, self.transition.state_dim(), self.checks)?;
         self.update_predicted(prior, z)
     }
 
@@ -165,6 +173,7 @@ pub struct Ekf<Tr, Ob> {
     transition: Tr,
     observation: Ob,
     covariance_update: CovarianceUpdate,
+    checks: InputChecks,
 }
 
 impl<Tr, Ob> Ekf<Tr, Ob> {
@@ -184,12 +193,19 @@ impl<Tr, Ob> Ekf<Tr, Ob> {
             transition,
             observation,
             covariance_update: CovarianceUpdate::Joseph,
+            checks: InputChecks::Full,
         })
     }
 
     /// Selects the covariance update form.
     pub fn with_covariance_update(mut self, form: CovarianceUpdate) -> Self {
         self.covariance_update = form;
+        self
+    }
+
+    /// Selects how much of the input state is verified ([`InputChecks::Full`] by default).
+    pub fn with_input_checks(mut self, checks: InputChecks) -> Self {
+        self.checks = checks;
         self
     }
 
@@ -220,7 +236,7 @@ where
 {
     fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
         let n = self.transition.state_dim();
-        validate_state(state, n)?;
+        validate_state(state, n, self.checks)?;
         let mean = self.transition.transition(&state.mean)?;
         check_dim("f(x)", n, mean.nrows())?;
         let f = self.transition.transition_jacobian(&state.mean)?;
@@ -228,7 +244,7 @@ where
     }
 
     fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>> {
-        validate_state(prior, self.transition.state_dim())?;
+        validate_state(prior, self.transition.state_dim(), self.checks)?;
         self.update_predicted(prior, z)
     }
 

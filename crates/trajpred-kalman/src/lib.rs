@@ -108,7 +108,9 @@ mod linalg;
 pub mod model;
 
 pub use error::{KalmanError, Result};
-pub use filter::{CovarianceUpdate, Filter, Smoother, Step, Update};
+pub use filter::{
+    CovarianceUpdate, Filter, InputChecks, PredictionWithCross, Smoother, Step, Update,
+};
 pub use kf::{Ekf, Kf};
 pub use model::{
     LinearObservation, LinearObservationModel, LinearTransition, LinearTransitionModel,

@@ -234,9 +234,10 @@ where
 }
 
 /// Validates a Gaussian state of dimension `n`: shapes, finite values, and a symmetric
-/// positive semi-definite covariance (see [`check_psd`]).
+/// positive semi-definite covariance (see [`check_psd`]); with `full = false` only shapes,
+/// finite values, symmetry and a non-negative diagonal (no factorisation).
 #[inline(always)]
-pub(crate) fn check_state<T, D>(state: &Gaussian<T, D>, n: usize) -> Result<()>
+pub(crate) fn check_state<T, D>(state: &Gaussian<T, D>, n: usize, full: bool) -> Result<()>
 where
     T: RealField + Copy,
     D: Dim,
@@ -245,7 +246,23 @@ where
     check_dim("state mean", n, state.mean.nrows())?;
     check_square(&state.covariance, n, "state covariance")?;
     check_finite(&state.mean, "state mean")?;
-    check_psd(&state.covariance, "P")
+    if full {
+        return check_psd(&state.covariance, "P");
+    }
+    let p = &state.covariance;
+    check_finite(p, "P")?;
+    let tol = symmetry_tolerance(p.amax());
+    for j in 0..n {
+        if p[(j, j)] < T::zero() {
+            return Err(KalmanError::NotPositiveDefinite { what: "P" });
+        }
+        for i in 0..j {
+            if (p[(i, j)] - p[(j, i)]).abs() > tol {
+                return Err(KalmanError::NotPositiveDefinite { what: "P" });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Replaces `m` by its symmetric part `(m + m^T) / 2` in place.

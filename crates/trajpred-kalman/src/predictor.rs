@@ -12,7 +12,7 @@
 //! [`Filter::update`] with the plain covariance form followed by [`Filter::predict`].
 
 use crate::error::Result;
-use crate::filter::{Filter, validate_state};
+use crate::filter::{Filter, InputChecks, validate_state};
 use crate::kf::Kf;
 use crate::linalg::{check_dim, check_finite, cholesky, symmetrise};
 use crate::model::{LinearObservationModel, LinearTransitionModel};
@@ -61,7 +61,7 @@ impl<Tr, Ob> Kf<Tr, Ob> {
         };
         let tr = self.transition();
         let ob = self.observation();
-        validate_state(prediction, tr.state_dim())?;
+        validate_state(prediction, tr.state_dim(), InputChecks::Full)?;
         check_dim("observation", ob.observation_dim(), z.nrows())?;
         check_finite(z, "observation")?;
         let a = tr.transition_matrix();

@@ -3,7 +3,8 @@
 
 use crate::error::{KalmanError, Result};
 use crate::filter::{
-    Filter, PredictionWithCross, Smoother, Update, gaussian_log_likelihood, validate_state,
+    Filter, InputChecks, PredictionWithCross, Smoother, Update, gaussian_log_likelihood,
+    validate_state,
 };
 use crate::linalg::{check_dim, check_finite, cholesky, symmetrise};
 use crate::model::{Observation, Transition, validate_models};
@@ -82,7 +83,7 @@ impl<T: RealField + Copy> MerweSigmaPoints<T> {
     {
         let n = state.mean.nrows();
         let w = self.weights(n)?;
-        validate_state(state, n)?;
+        validate_state(state, n, InputChecks::Full)?;
         let l = w.spread(&state.covariance)?;
         let mut out = Vec::with_capacity(2 * n + 1);
         out.push(state.mean.clone());
@@ -242,6 +243,7 @@ pub struct Ukf<T, Tr, Ob> {
     observation: Ob,
     points: MerweSigmaPoints<T>,
     weights: SigmaWeights<T>,
+    checks: InputChecks,
 }
 
 impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
@@ -263,7 +265,15 @@ impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
             observation,
             points,
             weights,
+            checks: InputChecks::Full,
         })
+    }
+
+    /// Selects how much of the input state is verified ([`InputChecks::Full`] by default;
+    /// the UKF's own Cholesky factorisation of `P` still rejects an indefinite `P`).
+    pub fn with_input_checks(mut self, checks: InputChecks) -> Self {
+        self.checks = checks;
+        self
     }
 
     /// The sigma-point parameters.
@@ -306,7 +316,7 @@ where
     }
 
     fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>> {
-        validate_state(prior, self.transition.state_dim())?;
+        validate_state(prior, self.transition.state_dim(), self.checks)?;
         self.update_predicted(prior, z)
     }
 
@@ -373,7 +383,7 @@ where
         filtered: &Gaussian<T, D>,
     ) -> Result<PredictionWithCross<T, D>> {
         let n = self.transition.state_dim();
-        validate_state(filtered, n)?;
+        validate_state(filtered, n, self.checks)?;
         let tr = &self.transition;
         let t = unscented_transform(
             filtered,

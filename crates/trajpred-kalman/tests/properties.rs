@@ -17,9 +17,9 @@ use trajpred_kalman::motion::{
 };
 use trajpred_kalman::sampling::{covariance_sqrt, observation_log_likelihood, sample_transition};
 use trajpred_kalman::{
-    CoordinatedTurn, CovarianceUpdate, Ekf, Filter, Ikf, Innovation, Kf, LinearObservation,
-    LinearTransition, MerweSigmaPoints, MultiStep, Observation, ObservationJacobian, RangeBearing,
-    Smoother, Transition, TransitionJacobian, Ukf,
+    CoordinatedTurn, CovarianceUpdate, Ekf, Filter, Ikf, Innovation, InputChecks, Kf,
+    LinearObservation, LinearTransition, MerweSigmaPoints, MultiStep, Observation,
+    ObservationJacobian, RangeBearing, Smoother, Transition, TransitionJacobian, Ukf,
 };
 
 fn assert_close<R: nalgebra::Dim, C: nalgebra::Dim, S1, S2>(
