@@ -25,16 +25,18 @@ use crate::geodesy::FOOT;
 use crate::io::{list, read_all};
 use crate::report::{LoadReport, SkipReason};
 use crate::track::{Cleaner, FrameKind, LoadOptions, RawPoint, Track};
-use serde::Deserialize;
+use serde::de::{self, Deserialize, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use serde_json::Value;
-use serde_json::value::RawValue;
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
 /// (icao24, callsign, flight_id)
 type FlightKey = (Option<String>, Option<String>, Option<String>);
 
-#[derive(Debug, Default, Deserialize)]
+/// One record, read leniently in a single pass: a field of the wrong type, or an element
+/// that is not an object, marks the record bad (skipped as malformed) instead of failing the
+/// whole document.
+#[derive(Debug, Default)]
 struct Record {
     timestamp: Option<f64>,
     icao24: Option<String>,
@@ -42,7 +44,186 @@ struct Record {
     latitude: Option<f64>,
     longitude: Option<f64>,
     altitude: Option<f64>,
-    flight_id: Option<Value>,
+    flight_id: Option<String>,
+    bad: Option<String>,
+}
+
+/// A JSON value read as a number (`null` is `None`); anything else is an error message.
+struct Num(Result<Option<f64>, &'static str>);
+/// A JSON value read as text (`null` is `None`; numbers and booleans are written out).
+struct Text(Result<Option<String>, &'static str>);
+
+macro_rules! lenient_visitor {
+    ($name:ident, $out:ident, $expect:literal, num: $num:expr, text: $text:expr, bool: $bool:expr) => {
+        struct $name;
+        impl<'de> Visitor<'de> for $name {
+            type Value = $out;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str($expect)
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<$out, E> {
+                Ok($out($num(v, None)))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<$out, E> {
+                Ok($out($num(v as f64, Some(v.to_string()))))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<$out, E> {
+                Ok($out($num(v as f64, Some(v.to_string()))))
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<$out, E> {
+                Ok($out($text(v)))
+            }
+            fn visit_bool<E: de::Error>(self, v: bool) -> Result<$out, E> {
+                Ok($out($bool(v)))
+            }
+            fn visit_unit<E: de::Error>(self) -> Result<$out, E> {
+                Ok($out(Ok(None)))
+            }
+            fn visit_none<E: de::Error>(self) -> Result<$out, E> {
+                Ok($out(Ok(None)))
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut a: A) -> Result<$out, A::Error> {
+                while a.next_element::<IgnoredAny>()?.is_some() {}
+                Ok($out(Err(concat!($expect, ", got an array"))))
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut a: A) -> Result<$out, A::Error> {
+                while a.next_entry::<IgnoredAny, IgnoredAny>()?.is_some() {}
+                Ok($out(Err(concat!($expect, ", got an object"))))
+            }
+        }
+        impl<'de> Deserialize<'de> for $out {
+            fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                d.deserialize_any($name)
+            }
+        }
+    };
+}
+
+lenient_visitor!(NumVisitor, Num, "a number or null",
+    num: |v: f64, _: Option<String>| Ok(Some(v)),
+    text: |_: &str| Err("a number or null, got a string"),
+    bool: |_: bool| Err("a number or null, got a boolean"));
+lenient_visitor!(TextVisitor, Text, "a string or null",
+    num: |v: f64, s: Option<String>| Ok(Some(s.unwrap_or_else(|| v.to_string()))),
+    text: |v: &str| Ok(Some(v.to_string())),
+    bool: |v: bool| Ok(Some(v.to_string())));
+
+/// The keys this loader reads; every other key is skipped without allocating.
+enum Key {
+    Timestamp,
+    Icao24,
+    Callsign,
+    Latitude,
+    Longitude,
+    Altitude,
+    FlightId,
+    Other,
+}
+
+impl<'de> Deserialize<'de> for Key {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl Visitor<'_> for V {
+            type Value = Key;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a field name")
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<Key, E> {
+                Ok(match v {
+                    "timestamp" => Key::Timestamp,
+                    "icao24" => Key::Icao24,
+                    "callsign" => Key::Callsign,
+                    "latitude" => Key::Latitude,
+                    "longitude" => Key::Longitude,
+                    "altitude" => Key::Altitude,
+                    "flight_id" => Key::FlightId,
+                    _ => Key::Other,
+                })
+            }
+        }
+        d.deserialize_str(V)
+    }
+}
+
+impl<'de> Deserialize<'de> for Record {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        fn not_object<T>(what: &str) -> Result<Record, T> {
+            Ok(Record {
+                bad: Some(format!("record is {what}, not an object")),
+                ..Record::default()
+            })
+        }
+        impl<'de> Visitor<'de> for V {
+            type Value = Record;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a record")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut a: A) -> Result<Record, A::Error> {
+                let mut r = Record::default();
+                while let Some(k) = a.next_key::<Key>()? {
+                    let (name, res) = match k {
+                        Key::Timestamp => (
+                            "timestamp",
+                            a.next_value::<Num>()?.0.map(|v| r.timestamp = v),
+                        ),
+                        Key::Latitude => {
+                            ("latitude", a.next_value::<Num>()?.0.map(|v| r.latitude = v))
+                        }
+                        Key::Longitude => (
+                            "longitude",
+                            a.next_value::<Num>()?.0.map(|v| r.longitude = v),
+                        ),
+                        Key::Altitude => {
+                            ("altitude", a.next_value::<Num>()?.0.map(|v| r.altitude = v))
+                        }
+                        Key::Icao24 => ("icao24", a.next_value::<Text>()?.0.map(|v| r.icao24 = v)),
+                        Key::Callsign => (
+                            "callsign",
+                            a.next_value::<Text>()?.0.map(|v| r.callsign = v),
+                        ),
+                        Key::FlightId => (
+                            "flight_id",
+                            a.next_value::<Text>()?.0.map(|v| r.flight_id = v),
+                        ),
+                        Key::Other => {
+                            a.next_value::<IgnoredAny>()?;
+                            ("", Ok(()))
+                        }
+                    };
+                    if let Err(e) = res
+                        && r.bad.is_none()
+                    {
+                        r.bad = Some(format!("{name}: expected {e}"));
+                    }
+                }
+                Ok(r)
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut a: A) -> Result<Record, A::Error> {
+                while a.next_element::<IgnoredAny>()?.is_some() {}
+                not_object("an array")
+            }
+            fn visit_f64<E: de::Error>(self, _: f64) -> Result<Record, E> {
+                not_object("a number")
+            }
+            fn visit_i64<E: de::Error>(self, _: i64) -> Result<Record, E> {
+                not_object("a number")
+            }
+            fn visit_u64<E: de::Error>(self, _: u64) -> Result<Record, E> {
+                not_object("a number")
+            }
+            fn visit_str<E: de::Error>(self, _: &str) -> Result<Record, E> {
+                not_object("a string")
+            }
+            fn visit_bool<E: de::Error>(self, _: bool) -> Result<Record, E> {
+                not_object("a boolean")
+            }
+            fn visit_unit<E: de::Error>(self) -> Result<Record, E> {
+                not_object("null")
+            }
+        }
+        d.deserialize_any(V)
+    }
 }
 
 /// Parses one JSON document (already decompressed) named `file`, adding to `report`.
@@ -62,13 +243,13 @@ pub fn parse_json(
     let mut records: Vec<(usize, Record)> = Vec::new();
     match first {
         Some(b'[') => {
-            let raws: Vec<&RawValue> = serde_json::from_slice(json).map_err(json_err)?;
-            records.reserve(raws.len());
-            for (i, raw) in raws.into_iter().enumerate() {
+            let all: Vec<Record> = serde_json::from_slice(json).map_err(json_err)?;
+            records.reserve(all.len());
+            for (i, mut r) in all.into_iter().enumerate() {
                 c.report.records_read += 1;
-                match serde_json::from_str::<Record>(raw.get()) {
-                    Ok(r) => records.push((i + 1, r)),
-                    Err(e) => c.malformed(i + 1, format!("record: {e}"))?,
+                match r.bad.take() {
+                    Some(e) => c.malformed(i + 1, format!("record: {e}"))?,
+                    None => records.push((i + 1, r)),
                 }
             }
         }
@@ -105,7 +286,11 @@ pub fn parse_json(
                         "icao24" => text(v).map(|x| r.icao24 = x),
                         "callsign" => text(v).map(|x| r.callsign = x),
                         "flight_id" => {
-                            r.flight_id = Some(v.clone());
+                            r.flight_id = match v {
+                                Value::Null => None,
+                                Value::String(s) => Some(s.clone()),
+                                other => Some(other.to_string()),
+                            };
                             Ok(())
                         }
                         _ => Ok(()),
@@ -136,12 +321,11 @@ pub fn parse_json(
     let mut order: Vec<FlightKey> = Vec::new();
     let mut groups: HashMap<FlightKey, Vec<RawPoint>> = HashMap::new();
     for (line, r) in records {
-        let flight = match r.flight_id {
-            None | Some(Value::Null) => None,
-            Some(Value::String(s)) => Some(s),
-            Some(v) => Some(v.to_string()),
-        };
-        let key = (r.icao24, r.callsign.map(|s| s.trim().to_string()), flight);
+        let key = (
+            r.icao24,
+            r.callsign.map(|s| s.trim().to_string()),
+            r.flight_id,
+        );
         let group = groups.entry(key.clone()).or_insert_with(|| {
             order.push(key);
             Vec::new()
