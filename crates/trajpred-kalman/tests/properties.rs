@@ -187,6 +187,13 @@ fn batch_equals_step_by_step_for_every_filter() {
         &Ukf::new(&tr, &ob, MerweSigmaPoints::default()).unwrap(),
         &zs,
     );
+    // the lighter input checks change nothing for valid input
+    check(
+        &Kf::new(&tr, &ob)
+            .unwrap()
+            .with_input_checks(InputChecks::Cheap),
+        &zs,
+    );
     for form in [CovarianceUpdate::Plain, CovarianceUpdate::Symmetrised] {
         check(
             &Kf::new(&tr, &ob).unwrap().with_covariance_update(form),
