@@ -124,4 +124,6 @@ pub mod ikf;
 pub mod predictor;
 pub use ikf::{Ikf, IkfStep, Innovation};
 pub use predictor::MultiStep;
+pub mod augmented;
 pub mod sampling;
+pub use augmented::{AugmentedUkf, NoisyObservation, NoisyTransition};

@@ -17,8 +17,8 @@ use trajpred_kalman::motion::{
 };
 use trajpred_kalman::sampling::{covariance_sqrt, observation_log_likelihood, sample_transition};
 use trajpred_kalman::{
-    CoordinatedTurn, CovarianceUpdate, Ekf, Filter, Ikf, Innovation, InputChecks, Kf,
-    LinearObservation, LinearTransition, MerweSigmaPoints, MultiStep, Observation,
+    AugmentedUkf, CoordinatedTurn, CovarianceUpdate, Ekf, Filter, Ikf, Innovation, InputChecks, Kf,
+    LinearObservation, LinearTransition, MerweSigmaPoints, MultiStep, NoisyTransition, Observation,
     ObservationJacobian, RangeBearing, Smoother, Transition, TransitionJacobian, Ukf,
 };
 
@@ -522,4 +522,92 @@ fn f32_filters_run() {
     let u = ukf.step(&x0, Some(&z)).unwrap();
     assert!((u.posterior().mean - s.posterior().mean).amax() < 1e-4);
     let _ = U1;
+}
+
+#[test]
+fn augmented_ukf_equals_kf_on_a_linear_model() {
+    // the joint unscented transform of linear f and h in [x; w; v] is exact: every prior,
+    // posterior, S, K and log-likelihood equals the KF's (1e-9 relative, rounding)
+    let (tr, ob) = cv2_models();
+    let kf = Kf::new(&tr, &ob).unwrap();
+    let aug = AugmentedUkf::new(&tr, &ob, MerweSigmaPoints::new(0.5, 2.0, 0.0)).unwrap();
+    let zs = noisy_observations(40, 8, 9);
+    let a = aug.filter(&x0_cv2(), &zs).unwrap();
+    let k = kf.filter(&x0_cv2(), &zs).unwrap();
+    for (sa, sk) in a.iter().zip(&k) {
+        assert_close(&sa.prior.mean, &sk.prior.mean, 1e-9, "prior mean");
+        assert_close(
+            &sa.prior.covariance,
+            &sk.prior.covariance,
+            1e-9,
+            "prior cov",
+        );
+        assert_close(&sa.posterior().mean, &sk.posterior().mean, 1e-9, "mean");
+        assert_close(
+            &sa.posterior().covariance,
+            &sk.posterior().covariance,
+            1e-9,
+            "cov",
+        );
+        if let (Some(ua), Some(uk)) = (&sa.update, &sk.update) {
+            assert_close(
+                &ua.innovation_covariance,
+                &uk.innovation_covariance,
+                1e-9,
+                "S",
+            );
+            assert_close(&ua.gain, &uk.gain, 1e-9, "K");
+            assert!((ua.log_likelihood - uk.log_likelihood).abs() < 1e-9);
+        }
+    }
+    assert_eq!(aug.predict(&x0_cv2()).unwrap(), a[0].prior);
+}
+
+/// `x' = x (1 + w)`: multiplicative process noise, which only the augmented form represents.
+struct Multiplicative {
+    q: Matrix1<f64>,
+}
+
+impl Transition<f64, U1> for Multiplicative {
+    fn transition(&self, x: &Vector1<f64>) -> trajpred_kalman::Result<Vector1<f64>> {
+        Ok(*x)
+    }
+    fn process_noise(&self) -> &Matrix1<f64> {
+        &self.q
+    }
+}
+
+impl NoisyTransition<f64, U1> for Multiplicative {
+    fn transition_with_noise(
+        &self,
+        x: &Vector1<f64>,
+        w: &Vector1<f64>,
+    ) -> trajpred_kalman::Result<Vector1<f64>> {
+        Ok(Vector1::new(x[0] * (1.0 + w[0])))
+    }
+}
+
+#[test]
+fn augmented_ukf_with_multiplicative_noise_by_hand() {
+    // x ~ N(mu, P), w ~ N(0, Q): the augmented sigma points lie on the axes, so the
+    // transform gives mean mu and variance P + mu^2 Q exactly (worked by hand: the x-points
+    // give y = x_i, the w-points y = mu (1 + w_i), the v-points y = mu; the PQ cross term
+    // of the true variance needs points off the axes). mu = 2, P = 0.5, Q = 0.1: 0.9.
+    let model = Multiplicative {
+        q: Matrix1::<f64>::new(0.1),
+    };
+    let ob = LinearObservation::new(Matrix1::<f64>::new(1.0), Matrix1::<f64>::new(1.0)).unwrap();
+    let aug = AugmentedUkf::new(&model, &ob, MerweSigmaPoints::new(0.7, 2.0, 0.0)).unwrap();
+    let x = Gaussian {
+        mean: Vector1::<f64>::new(2.0),
+        covariance: Matrix1::<f64>::new(0.5),
+    };
+    let prior = aug.predict(&x).unwrap();
+    assert!((prior.mean[0] - 2.0).abs() < 1e-12);
+    assert!((prior.covariance[(0, 0)] - 0.9).abs() < 1e-12);
+    // update with z = 3: S = 0.9 + 1, K = 0.9 / 1.9, x = 2 + K
+    let s = aug.step(&x, Some(&Vector1::<f64>::new(3.0))).unwrap();
+    let u = s.update.unwrap();
+    assert!((u.posterior.mean[0] - (2.0 + 0.9 / 1.9)).abs() < 1e-12);
+    assert!((u.posterior.covariance[(0, 0)] - (0.9 - 0.81 / 1.9)).abs() < 1e-12);
 }
