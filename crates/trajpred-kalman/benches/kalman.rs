@@ -152,7 +152,7 @@ fn ukf_step(c: &mut Criterion) {
     let ct = CoordinatedTurn::new(0.5, 0.2, 1e-3).expect("model");
     let rb = RangeBearing::new(Vector2::new(-20.0, 15.0), 0, 2, 0.5, 1e-3).expect("model");
     let ukf = Ukf::new(ct, rb, MerweSigmaPoints::new(0.5, 2.0, -2.0)).expect("filter");
-    let ukf_cheap = ukf.clone().with_input_checks(InputChecks::Cheap);
+
     let state = Gaussian {
         mean: Vector5::new(0.5, 7.0, -0.5, 2.5, 0.1),
         covariance: Matrix5::from_diagonal(&Vector5::new(2.0, 1.0, 2.0, 1.0, 0.01)),
@@ -162,14 +162,6 @@ fn ukf_step(c: &mut Criterion) {
     g.bench_function("trajpred", |b| {
         b.iter(|| {
             let s = ukf
-                .step(black_box(&state), Some(black_box(&z)))
-                .expect("step");
-            black_box(s.update.map(|u| u.posterior))
-        })
-    });
-    g.bench_function("trajpred_cheap_input_checks", |b| {
-        b.iter(|| {
-            let s = ukf_cheap
                 .step(black_box(&state), Some(black_box(&z)))
                 .expect("step");
             black_box(s.update.map(|u| u.posterior))

@@ -299,10 +299,12 @@ impl<T: RealField + Copy> CoordinatedTurn<T> {
             ]
         } else {
             let w2 = w * w;
-            let half = wt * k(0.5);
-            let sh = half.sin();
-            // 1 - cos(wT) = 2 sin^2(wT / 2), free of cancellation
-            let one_minus_c = k(2.0) * sh * sh;
+            // 1 - cos(wT) without cancellation: sin^2 / (1 + cos) while cos > 0
+            let one_minus_c = if c > T::zero() {
+                s * s / (T::one() + c)
+            } else {
+                T::one() - c
+            };
             [
                 s / w,
                 one_minus_c / w,

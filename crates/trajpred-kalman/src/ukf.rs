@@ -226,6 +226,11 @@ where
     })
 }
 
+/// The UKF validates shapes, finiteness and symmetry of its input state; definiteness is
+/// checked by the Cholesky factorisation of `(n + lambda) P` that the sigma points need
+/// anyway (stricter: `P` must be positive definite), so no second factorisation is spent.
+const UKF_CHECKS: InputChecks = InputChecks::Cheap;
+
 /// The unscented Kalman filter with additive noise and Merwe's scaled sigma points.
 ///
 /// Predict: sigma points of `N(x(k-1|k-1), P(k-1|k-1))` through `f`; `x(k|k-1)` their
@@ -243,7 +248,6 @@ pub struct Ukf<T, Tr, Ob> {
     observation: Ob,
     points: MerweSigmaPoints<T>,
     weights: SigmaWeights<T>,
-    checks: InputChecks,
 }
 
 impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
@@ -265,15 +269,7 @@ impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
             observation,
             points,
             weights,
-            checks: InputChecks::Full,
         })
-    }
-
-    /// Selects how much of the input state is verified ([`InputChecks::Full`] by default;
-    /// the UKF's own Cholesky factorisation of `P` still rejects an indefinite `P`).
-    pub fn with_input_checks(mut self, checks: InputChecks) -> Self {
-        self.checks = checks;
-        self
     }
 
     /// The sigma-point parameters.
@@ -316,7 +312,7 @@ where
     }
 
     fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>> {
-        validate_state(prior, self.transition.state_dim(), self.checks)?;
+        validate_state(prior, self.transition.state_dim(), UKF_CHECKS)?;
         self.update_predicted(prior, z)
     }
 
@@ -383,7 +379,7 @@ where
         filtered: &Gaussian<T, D>,
     ) -> Result<PredictionWithCross<T, D>> {
         let n = self.transition.state_dim();
-        validate_state(filtered, n, self.checks)?;
+        validate_state(filtered, n, UKF_CHECKS)?;
         let tr = &self.transition;
         let t = unscented_transform(
             filtered,
