@@ -1,0 +1,544 @@
+//! [`Mkpf`]: the particle filter of the MKPF paper (SPEC C.1), whose every particle carries
+//! a mean and a covariance and proposes from a UKF step followed by an EKF step, both the
+//! Kalman crate's own (`trajpred_kalman::Ukf`, `trajpred_kalman::Ekf`).
+
+use crate::cloud::ParticleCloud;
+use crate::error::{ParticleError, Result};
+use crate::gauss::{
+    Density, first_non_finite, log_det_half, psd_factor, push_normals, shifted, to_f64,
+};
+use crate::pf::{
+    MIN_PARTICLES_PER_TASK, ParticleFiltering, PfConfig, StepSummary, check_observation,
+    log_likelihood, predict_clouds, propagate_one, weigh_and_select,
+};
+use crate::weights::normalize_log_weights;
+use nalgebra::allocator::Allocator;
+use nalgebra::{Cholesky, DefaultAllocator, Dim, OMatrix, OVector, RealField};
+use rand::Rng;
+use rayon::prelude::*;
+use std::marker::PhantomData;
+use trajpred_core::Gaussian;
+use trajpred_kalman::{
+    Ekf, Filter, KalmanError, MerweSigmaPoints, Observation, ObservationJacobian,
+    TransitionJacobian, Ukf,
+};
+
+/// How the EKF step of the MKPF proposal uses the UKF step's result (SPEC C.1 leaves it
+/// open; see `docs/particle.md`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum EkfStage {
+    /// Default. The EKF update starts from the UKF **prediction** `N(x(k|k-1), P(k|k-1))` and
+    /// linearises `h` at the UKF **estimate** `x_ukf(k|k)` (one iterated-EKF refinement):
+    /// `y = z - h(x_ukf) - H (x(k|k-1) - x_ukf)`, `H = dh/dx(x_ukf)`. The observation is
+    /// used once, and the linearisation point is the best one available.
+    #[default]
+    Relinearized,
+    /// The literal sequence "UKF update, then EKF update": the UKF posterior is the prior
+    /// of an EKF update by the same `z_k`. Uses `z_k` twice, so the proposal is narrower
+    /// than the posterior (the weights of eq. 9 still correct for it).
+    Sequential,
+    /// No EKF step: the proposal is the UKF posterior (van der Merwe's unscented particle
+    /// filter), for comparison.
+    UkfOnly,
+}
+
+/// Which prior the UKF step of particle `i` starts from (SPEC C.1 leaves the meaning of the
+/// particle's "mean and covariance" open; see `docs/particle.md`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ParticlePrior {
+    /// Default: the paper's Algorithm 1 (van der Merwe's unscented particle filter). The UKF
+    /// step starts from `N(x_(k-1)^i, P_(k-1)^i)`, `P_(k-1)^i` the particle's previous
+    /// proposal covariance (`P_0` at the start). When `Q` is small against `P^i` in the
+    /// directions the observation does not fix, the proposal is much wider than the
+    /// transition density of eq. 9 and the weights degenerate (see `docs/particle.md`).
+    #[default]
+    Carried,
+    /// The UKF step conditions on the particle: its prediction is exactly
+    /// `N(f(x_(k-1)^i), Q)` (the unscented transform of a point mass), so the UKF+EKF update
+    /// approximates the optimal proposal `p(x_k | x_(k-1)^i, z_k)`. The covariance each
+    /// particle carries is then its last proposal covariance, reported but not fed back.
+    Conditioned,
+}
+
+/// `h` linearised at a point `a`: `h(a) + H(a) (x - a)`, with `h`'s residual, noise and
+/// normalisation. Lets the Kalman crate's `Ekf::update` (which linearises at the prior
+/// mean) linearise at the UKF estimate instead.
+struct Linearized<'a, T: RealField, D: Dim, M: Dim, Ob>
+where
+    DefaultAllocator: Allocator<D> + Allocator<M> + Allocator<M, D>,
+{
+    inner: &'a Ob,
+    at: OVector<T, D>,
+    h_at: OVector<T, M>,
+    jacobian: OMatrix<T, M, D>,
+}
+
+impl<T, D, M, Ob> Observation<T, D, M> for Linearized<'_, T, D, M, Ob>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    Ob: Observation<T, D, M>,
+    DefaultAllocator:
+        Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M> + Allocator<M, D>,
+{
+    fn observe(&self, x: &OVector<T, D>) -> trajpred_kalman::Result<OVector<T, M>> {
+        Ok(&self.h_at + &self.jacobian * (x - &self.at))
+    }
+    fn observation_noise(&self) -> &OMatrix<T, M, M> {
+        self.inner.observation_noise()
+    }
+    fn observation_dim(&self) -> usize {
+        self.inner.observation_dim()
+    }
+    fn observation_residual(&self, a: &OVector<T, M>, b: &OVector<T, M>) -> OVector<T, M> {
+        self.inner.observation_residual(a, b)
+    }
+    fn normalize_observation(&self, z: OVector<T, M>) -> OVector<T, M> {
+        self.inner.normalize_observation(z)
+    }
+}
+
+impl<T, D, M, Ob> ObservationJacobian<T, D, M> for Linearized<'_, T, D, M, Ob>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    Ob: Observation<T, D, M>,
+    DefaultAllocator:
+        Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M> + Allocator<M, D>,
+{
+    fn observation_jacobian(
+        &self,
+        _x: &OVector<T, D>,
+    ) -> trajpred_kalman::Result<OMatrix<T, M, D>> {
+        Ok(self.jacobian.clone())
+    }
+}
+
+/// The MKPF of Zhao et al. 2015 (SPEC C.1, Algorithm 1). Particle `i` carries a sample
+/// `x^i` and a covariance `P^i`. At step `k`, for each particle:
+///
+/// 1. a UKF step (Merwe sigma points, eq. 10-19) from `N(x_(k-1)^i, P_(k-1)^i)` by the
+///    observation `z_k`: prediction `N(x(k|k-1), P(k|k-1))` and estimate `x_ukf`;
+/// 2. an EKF step (eq. 20-24) that uses the UKF result as its prior (see [`EkfStage`]),
+///    giving the proposal `q = N(x_bar_k^i, P_k^i)`;
+/// 3. a draw `x_k^i ~ q`, weighted by eq. 9:
+///    `w_k^i ∝ w_(k-1)^i p(z_k | x_k^i) p(x_k^i | x_(k-1)^i) / q(x_k^i | x_(k-1)^i, z_k)`,
+///    with `p(z | x) = N(z; h(x), R)` and `p(x_k | x_(k-1)) = N(x_k; f(x_(k-1)), Q)`;
+///
+/// then the log-weights are normalised and the particles (with their covariances)
+/// resampled, by the residual scheme every step by default ([`PfConfig`]).
+///
+/// The transition density needs `Q` positive definite (a singular `Q` is
+/// [`ParticleError::NotPositiveDefinite`] at construction). A particle whose UKF or EKF step
+/// fails (e.g. `S` not positive definite) falls back to the transition prior as its proposal
+/// for that step (counted in [`StepSummary::fallbacks`]). A missing observation propagates
+/// each particle through the transition (weights unchanged) and its covariance by the UKF
+/// prediction. The per-particle work runs in parallel with rayon; every random number is
+/// drawn before it, so a seed gives the same result on any number of threads.
+///
+/// ```
+/// use nalgebra::{Matrix5, Vector2, Vector5, U2, U5};
+/// use rand::SeedableRng;
+/// use trajpred_core::Gaussian;
+/// use trajpred_kalman::{CoordinatedTurn, MerweSigmaPoints, Observation, RangeBearing, Transition};
+/// use trajpred_particle::{Mkpf, ParticleFiltering};
+/// // a target turning at 0.05 rad/s, seen in range (sd 1 m) and bearing (sd 1 mrad)
+/// let q = Matrix5::from_diagonal(&Vector5::new(4.0, 1.0, 4.0, 1.0, 1e-4));
+/// let ct = CoordinatedTurn::with_process_noise(1.0, q)?;
+/// let rb = RangeBearing::new(Vector2::new(0.0, 0.0), 0, 2, 1.0, 1e-6)?;
+/// let mut truth = Vector5::new(1000.0, 10.0, 1000.0, 0.0, 0.05);
+/// let p0 = Matrix5::from_diagonal(&Vector5::new(25.0, 4.0, 25.0, 4.0, 1e-3));
+/// let x0 = Gaussian { mean: truth, covariance: p0 };
+/// let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+/// let mut mkpf = Mkpf::<f64, U5, U2, _, _>::from_gaussian(
+///     ct.clone(), rb.clone(), &x0, 20, MerweSigmaPoints::default(), &mut rng)?;
+/// for _ in 0..10 {
+///     truth = ct.transition(&truth)?;
+///     let z = rb.observe(&truth)?; // noise-free here, to keep the example short
+///     mkpf.step(Some(&z), &mut rng)?;
+/// }
+/// let est = mkpf.cloud().estimate();
+/// let err = ((est.mean[0] - truth[0]).powi(2) + (est.mean[2] - truth[2]).powi(2)).sqrt();
+/// assert!(err < 10.0, "position error {err}");
+/// // the particle cloud five steps ahead, and its 90% interval of x
+/// let ahead = mkpf.predict(5, &mut rng)?;
+/// let (lo, hi) = (ahead[4].quantile(0, 0.05)?, ahead[4].quantile(0, 0.95)?);
+/// assert!(lo < hi);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct Mkpf<T, D, M, Tr, Ob>
+where
+    T: RealField,
+    D: Dim,
+    M: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M>,
+{
+    transition: Tr,
+    observation: Ob,
+    points: MerweSigmaPoints<T>,
+    stage: EkfStage,
+    prior_mode: ParticlePrior,
+    cloud: ParticleCloud<T, D>,
+    covariances: Vec<OMatrix<T, D, D>>,
+    config: PfConfig,
+    q_factor: OMatrix<T, D, D>,
+    transition_density: Density<T, D>,
+    likelihood: Density<T, M>,
+    _m: PhantomData<fn() -> M>,
+}
+
+/// The outcome of one particle's proposal.
+struct Moved<T: RealField, D: Dim>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    x: OVector<T, D>,
+    p: OMatrix<T, D, D>,
+    log_increment: f64,
+    fallback: bool,
+}
+
+impl<T, D, M, Tr, Ob> Mkpf<T, D, M, Tr, Ob>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    Tr: TransitionJacobian<T, D> + Sync,
+    Ob: ObservationJacobian<T, D, M> + Sync,
+    DefaultAllocator: Allocator<D>
+        + Allocator<D, D>
+        + Allocator<M>
+        + Allocator<M, M>
+        + Allocator<D, M>
+        + Allocator<M, D>,
+    OVector<T, D>: Send + Sync,
+    OMatrix<T, D, D>: Send + Sync,
+    OVector<T, M>: Sync,
+    OMatrix<T, M, M>: Send + Sync,
+{
+    /// An MKPF over `cloud`, every particle starting with the covariance `initial_covariance`
+    /// (the paper's `P_0^i = P_0`), with the sigma-point parameters `points` (the paper:
+    /// `alpha = 1e-3, beta = 2, kappa = 0`, [`MerweSigmaPoints::default`]). Errors:
+    /// [`ParticleError::DimensionMismatch`], [`ParticleError::NotPositiveDefinite`] (`"Q"`
+    /// must be positive definite, `"R"`, `"P"`), [`ParticleError::Kalman`] (degenerate
+    /// sigma points).
+    pub fn new(
+        transition: Tr,
+        observation: Ob,
+        cloud: ParticleCloud<T, D>,
+        initial_covariance: OMatrix<T, D, D>,
+        points: MerweSigmaPoints<T>,
+    ) -> Result<Self> {
+        let n = transition.state_dim();
+        if cloud.dim() != n {
+            return Err(ParticleError::DimensionMismatch {
+                what: "particles vs transition",
+                expected: n,
+                got: cloud.dim(),
+            });
+        }
+        if initial_covariance.nrows() != n || initial_covariance.ncols() != n {
+            return Err(ParticleError::DimensionMismatch {
+                what: "initial covariance vs transition",
+                expected: n,
+                got: initial_covariance.nrows(),
+            });
+        }
+        psd_factor(&initial_covariance, "P")?;
+        points.weights(n)?;
+        let q_factor = psd_factor(transition.process_noise(), "Q")?;
+        let transition_density = Density::new(transition.process_noise(), "Q")?;
+        let likelihood = Density::new(observation.observation_noise(), "R")?;
+        let covariances = vec![initial_covariance; cloud.len()];
+        Ok(Mkpf {
+            transition,
+            observation,
+            points,
+            stage: EkfStage::default(),
+            prior_mode: ParticlePrior::default(),
+            cloud,
+            covariances,
+            config: PfConfig::default(),
+            q_factor,
+            transition_density,
+            likelihood,
+            _m: PhantomData,
+        })
+    }
+
+    /// An MKPF whose `n` particles are drawn from `initial`, each with the covariance
+    /// `initial.covariance` (Algorithm 1, step 1).
+    pub fn from_gaussian<R: Rng + ?Sized>(
+        transition: Tr,
+        observation: Ob,
+        initial: &Gaussian<T, D>,
+        n: usize,
+        points: MerweSigmaPoints<T>,
+        rng: &mut R,
+    ) -> Result<Self> {
+        let cloud = ParticleCloud::sample(initial, n, rng)?;
+        Self::new(
+            transition,
+            observation,
+            cloud,
+            initial.covariance.clone(),
+            points,
+        )
+    }
+
+    /// Sets the resampling configuration (validated).
+    pub fn with_config(mut self, config: PfConfig) -> Result<Self> {
+        config.policy.validate()?;
+        self.config = config;
+        Ok(self)
+    }
+
+    /// Selects how the EKF step uses the UKF result.
+    pub fn with_ekf_stage(mut self, stage: EkfStage) -> Self {
+        self.stage = stage;
+        self
+    }
+
+    /// Selects the prior of each particle's UKF step.
+    pub fn with_particle_prior(mut self, prior: ParticlePrior) -> Self {
+        self.prior_mode = prior;
+        self
+    }
+
+    /// The prior of each particle's UKF step.
+    pub fn particle_prior(&self) -> ParticlePrior {
+        self.prior_mode
+    }
+
+    /// The resampling configuration.
+    pub fn config(&self) -> &PfConfig {
+        &self.config
+    }
+
+    /// The EKF stage in use.
+    pub fn ekf_stage(&self) -> EkfStage {
+        self.stage
+    }
+
+    /// The per-particle covariances `P^i`, in particle order.
+    pub fn covariances(&self) -> &[OMatrix<T, D, D>] {
+        &self.covariances
+    }
+
+    /// The UKF prediction of one particle by [`ParticlePrior`].
+    fn ukf_prediction(
+        &self,
+        ukf: &Ukf<T, &Tr, &Ob>,
+        prior: &Gaussian<T, D>,
+    ) -> trajpred_kalman::Result<Gaussian<T, D>> {
+        match self.prior_mode {
+            ParticlePrior::Carried => ukf.predict(prior),
+            ParticlePrior::Conditioned => Ok(Gaussian {
+                mean: self.transition.transition(&prior.mean)?,
+                covariance: self.transition.process_noise().clone(),
+            }),
+        }
+    }
+
+    /// The Gaussian proposal `q = N(x_bar, P)` of one particle (UKF step, then EKF step).
+    fn proposal(
+        &self,
+        ukf: &Ukf<T, &Tr, &Ob>,
+        prior: &Gaussian<T, D>,
+        z: &OVector<T, M>,
+    ) -> trajpred_kalman::Result<(Gaussian<T, D>, Gaussian<T, D>)> {
+        let pred = self.ukf_prediction(ukf, prior)?;
+        let ukf_post = ukf.update(&pred, z)?.posterior;
+        let q = match self.stage {
+            EkfStage::UkfOnly => ukf_post,
+            EkfStage::Sequential => {
+                let ekf = Ekf::new(&self.transition, &self.observation)?;
+                ekf.update(&ukf_post, z)?.posterior
+            }
+            EkfStage::Relinearized => {
+                let lin = Linearized {
+                    inner: &self.observation,
+                    h_at: self.observation.observe(&ukf_post.mean)?,
+                    jacobian: self.observation.observation_jacobian(&ukf_post.mean)?,
+                    at: ukf_post.mean,
+                };
+                let ekf = Ekf::new(&self.transition, &lin)?;
+                ekf.update(&pred, z)?.posterior
+            }
+        };
+        Ok((pred, q))
+    }
+
+    /// One particle's move: the proposal draw and its weight increment (eq. 9), or the
+    /// fallback to the transition prior.
+    fn move_particle(
+        &self,
+        ukf: &Ukf<T, &Tr, &Ob>,
+        x: &OVector<T, D>,
+        p: &OMatrix<T, D, D>,
+        e: &[T],
+        z: Option<&OVector<T, M>>,
+    ) -> Result<Moved<T, D>> {
+        let prior = Gaussian {
+            mean: x.clone(),
+            covariance: p.clone(),
+        };
+        let Some(z) = z else {
+            let xn = propagate_one(&self.transition, &self.q_factor, x, e)?;
+            let pn = ukf
+                .predict(&prior)
+                .map_or_else(|_| p.clone(), |g| g.covariance);
+            return Ok(Moved {
+                x: xn,
+                p: pn,
+                log_increment: 0.0,
+                fallback: false,
+            });
+        };
+        match self.propose(ukf, &prior, z, e) {
+            Ok(Some(m)) => Ok(m),
+            Ok(None) | Err(_) => {
+                let xn = propagate_one(&self.transition, &self.q_factor, x, e)?;
+                let ll = log_likelihood(&self.observation, &self.likelihood, &xn, z)?;
+                Ok(Moved {
+                    x: xn,
+                    p: p.clone(),
+                    log_increment: ll,
+                    fallback: true,
+                })
+            }
+        }
+    }
+
+    /// The MKPF proposal draw; `Ok(None)` or `Err` asks for the fallback.
+    fn propose(
+        &self,
+        ukf: &Ukf<T, &Tr, &Ob>,
+        prior: &Gaussian<T, D>,
+        z: &OVector<T, M>,
+        e: &[T],
+    ) -> std::result::Result<Option<Moved<T, D>>, KalmanError> {
+        let (_, q) = self.proposal(ukf, prior, z)?;
+        let Some(chol) = Cholesky::new(q.covariance.clone()) else {
+            return Ok(None);
+        };
+        let l = chol.l();
+        let xn = shifted(&q.mean, &l, e);
+        if first_non_finite(&xn).is_some() {
+            return Ok(None);
+        }
+        // ln q(x) with x - mean = L e: -(n ln 2 pi + ln det P + |e|^2) / 2
+        let e2: f64 = e.iter().map(|v| to_f64(*v) * to_f64(*v)).sum();
+        let n = e.len() as f64;
+        let log_q = -0.5 * (n * (2.0 * std::f64::consts::PI).ln() + e2) - log_det_half(&chol);
+        let fx = self.transition.transition(&prior.mean)?;
+        let log_trans = self
+            .transition_density
+            .log_density(&self.transition.state_residual(&xn, &fx));
+        let Ok(log_lik) = log_likelihood(&self.observation, &self.likelihood, &xn, z) else {
+            return Ok(None);
+        };
+        let inc = log_lik + log_trans - log_q;
+        if inc.is_nan() || inc == f64::INFINITY {
+            return Ok(None);
+        }
+        Ok(Some(Moved {
+            x: xn,
+            p: q.covariance,
+            log_increment: inc,
+            fallback: false,
+        }))
+    }
+}
+
+impl<T, D, M, Tr, Ob> ParticleFiltering<T, D, M> for Mkpf<T, D, M, Tr, Ob>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    Tr: TransitionJacobian<T, D> + Sync,
+    Ob: ObservationJacobian<T, D, M> + Sync,
+    DefaultAllocator: Allocator<D>
+        + Allocator<D, D>
+        + Allocator<M>
+        + Allocator<M, M>
+        + Allocator<D, M>
+        + Allocator<M, D>,
+    OVector<T, D>: Send + Sync,
+    OMatrix<T, D, D>: Send + Sync,
+    OVector<T, M>: Sync,
+    OMatrix<T, M, M>: Send + Sync,
+{
+    fn step<R: Rng + ?Sized>(
+        &mut self,
+        z: Option<&OVector<T, M>>,
+        rng: &mut R,
+    ) -> Result<StepSummary<T, D>> {
+        if let Some(z) = z {
+            check_observation(z, self.observation.observation_dim())?;
+        }
+        let n = self.cloud.dim();
+        let count = self.cloud.len();
+        let mut noise: Vec<T> = Vec::new();
+        push_normals(rng, count * n, &mut noise);
+        let ukf = Ukf::new(&self.transition, &self.observation, self.points)?;
+        let this = &*self;
+        let moved: Vec<Moved<T, D>> = this
+            .cloud
+            .particles()
+            .par_iter()
+            .zip(this.covariances.par_iter())
+            .zip(noise.par_chunks(n))
+            .with_min_len((MIN_PARTICLES_PER_TASK / 64).max(1))
+            .map(|((x, p), e)| this.move_particle(&ukf, x, p, e, z))
+            .collect::<Result<_>>()?;
+        let mut log_w: Vec<f64> = this
+            .cloud
+            .log_weights()
+            .iter()
+            .zip(&moved)
+            .map(|(l, m)| l + m.log_increment)
+            .collect();
+        let (select, ess, lse) = weigh_and_select(&mut log_w, &self.config, rng)?;
+        let fallbacks = moved.iter().filter(|m| m.fallback).count();
+        let (mut particles, mut covs): (Vec<_>, Vec<_>) =
+            moved.into_iter().map(|m| (m.x, m.p)).unzip();
+        let weighted = ParticleCloud::new(particles.clone(), log_w.clone())?;
+        let estimate = weighted.estimate();
+        let resampled = select.is_some();
+        if let Some(idx) = select {
+            particles = idx.iter().map(|&i| particles[i].clone()).collect();
+            covs = idx.iter().map(|&i| covs[i].clone()).collect();
+            log_w = vec![0.0; count];
+        }
+        let (ps, ws) = self.cloud.parts_mut();
+        *ps = particles;
+        *ws = log_w;
+        if resampled {
+            normalize_log_weights(ws)?;
+        }
+        self.covariances = covs;
+        Ok(StepSummary {
+            estimate,
+            ess,
+            resampled,
+            log_likelihood: if z.is_some() { lse } else { 0.0 },
+            fallbacks,
+        })
+    }
+
+    fn cloud(&self) -> &ParticleCloud<T, D> {
+        &self.cloud
+    }
+
+    fn predict<R: Rng + ?Sized>(
+        &self,
+        steps: usize,
+        rng: &mut R,
+    ) -> Result<Vec<ParticleCloud<T, D>>> {
+        predict_clouds(&self.transition, &self.q_factor, &self.cloud, steps, rng)
+    }
+}

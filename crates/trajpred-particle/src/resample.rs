@@ -1,0 +1,538 @@
+//! Resampling: residual, systematic, stratified and multinomial schemes behind one trait,
+//! [`Resampler`], with an injected random number generator and allocation-free variants
+//! that write ancestor indices into a caller's buffer.
+//!
+//! Every scheme takes non-negative weights (not necessarily normalised; they are divided by
+//! their sum `W`) and writes `n = out.len()` ancestor indices. With `C_i = w_0 + ... + w_i`
+//! the running sum, an index `i` is selected by a position `p in [0, W)` when
+//! `C_(i-1) <= p < C_i`, so a particle of zero weight is never selected. Positions that
+//! rounding pushes to `W` or beyond select the last particle of positive weight: no scheme
+//! indexes past the end (filterpy 2.0.0's systematic resampler does when its offset rounds
+//! up to 1).
+//!
+//! | scheme | positions `p_j / W` (`j = 0..n`) | count of particle `i` |
+//! |---|---|---|
+//! | [`Systematic`] | `(j + u) / n`, one `u ~ U[0, 1)` | `floor(n w_i)` or `ceil(n w_i)` |
+//! | [`Stratified`] | `(j + u_j) / n`, `u_j ~ U[0, 1)` i.i.d. | within 2 of `n w_i` |
+//! | [`Multinomial`] | i.i.d. `U[0, 1)` | `Binomial(n, w_i)` |
+//! | [`Residual`] | `floor(n w_i)` copies, then `n - sum floor(n w_i)` multinomial draws from the residuals `n w_i - floor(n w_i)` | `>= floor(n w_i)` |
+//!
+//! All four are unbiased: `E[count_i] = n w_i / W`. The residual scheme follows the
+//! textbook (Liu and Chen 1998); filterpy 2.0.0's `residual_resample` draws the remainder
+//! from `w_i - floor(n w_i)` instead of `n w_i - floor(n w_i)`, which is biased (filterpy
+//! issue #290).
+//!
+//! The random variants ([`Resampler::resample_into`]) run in `O(n + N)` without allocating:
+//! the multinomial and residual remainders draw *sorted* uniforms as normalised cumulative
+//! sums of exponential variates (the order statistics of uniforms), so the selection is one
+//! merge pass instead of a binary search per draw; the resulting indices come out sorted.
+//! The deterministic variants ([`systematic_indices`], [`stratified_indices`],
+//! [`multinomial_indices`], [`residual_indices`]) take the uniforms as input and follow the
+//! order of the given uniforms (the reference definitions used by the tests).
+
+use crate::error::{ParticleError, Result};
+use rand::{Rng, RngExt};
+use rand_distr::{Distribution, Exp1};
+
+/// A resampling scheme: from weights, draw ancestor indices.
+pub trait Resampler {
+    /// Writes `out.len()` ancestor indices drawn according to `weights` (non-negative, not
+    /// necessarily normalised) into `out`, without allocating.
+    ///
+    /// Errors: [`ParticleError::Empty`] (no weights), [`ParticleError::InvalidWeight`]
+    /// (negative or non-finite), [`ParticleError::AllWeightsZero`],
+    /// [`ParticleError::NonFinite`] (the sum of the weights overflows).
+    fn resample_into<R: Rng + ?Sized>(
+        &self,
+        weights: &[f64],
+        rng: &mut R,
+        out: &mut [usize],
+    ) -> Result<()>;
+
+    /// Draws `n` ancestor indices into a new vector (see [`Resampler::resample_into`]).
+    fn resample<R: Rng + ?Sized>(
+        &self,
+        weights: &[f64],
+        n: usize,
+        rng: &mut R,
+    ) -> Result<Vec<usize>> {
+        let mut out = vec![0; n];
+        self.resample_into(weights, rng, &mut out)?;
+        Ok(out)
+    }
+
+    /// The scheme's name.
+    fn name(&self) -> &'static str;
+}
+
+/// Validated weights: their sum and the index of the last positive weight.
+#[derive(Debug, Clone, Copy)]
+struct Checked {
+    total: f64,
+    last: usize,
+}
+
+fn check_weights(weights: &[f64]) -> Result<Checked> {
+    if weights.is_empty() {
+        return Err(ParticleError::Empty { what: "weights" });
+    }
+    let mut total = 0.0f64;
+    let mut last = None;
+    for (index, &value) in weights.iter().enumerate() {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(ParticleError::InvalidWeight { index, value });
+        }
+        if value > 0.0 {
+            last = Some(index);
+        }
+        total += value;
+    }
+    let Some(last) = last else {
+        return Err(ParticleError::AllWeightsZero {
+            count: weights.len(),
+        });
+    };
+    if !total.is_finite() {
+        return Err(ParticleError::NonFinite {
+            what: "sum of weights",
+            index: 0,
+        });
+    }
+    Ok(Checked { total, last })
+}
+
+fn check_uniform(index: usize, value: f64) -> Result<()> {
+    if (0.0..=1.0).contains(&value) {
+        Ok(())
+    } else {
+        Err(ParticleError::InvalidUniform { index, value })
+    }
+}
+
+/// The merge pass: for non-decreasing positions `pos(j)` (in units of the weights), writes
+/// the index `i` with `C_(i-1) <= pos(j) < C_i` into `out[j]`; positions at or beyond the
+/// total select `last` (the last positive weight).
+#[inline]
+fn merge_sorted(
+    weights: &[f64],
+    last: usize,
+    out: &mut [usize],
+    mut pos: impl FnMut(usize) -> f64,
+) {
+    let mut i = 0usize;
+    let mut c = weights[0];
+    for (j, o) in out.iter_mut().enumerate() {
+        let p = pos(j);
+        while p >= c && i < last {
+            i += 1;
+            c += weights[i];
+        }
+        *o = i;
+    }
+}
+
+/// Systematic resampling for a given offset `u in [0, 1]`: positions `(j + u) / n`
+/// (`n = out.len()`), written into `out`.
+///
+/// With normalised weights this is exactly filterpy's `systematic_resample` with
+/// `random()` returning `u`, except at the edge: an offset so close to 1 that the last
+/// position reaches the rounded sum of the weights selects the last particle of positive
+/// weight here, where filterpy indexes past the end of its cumulative sum.
+///
+/// ```
+/// use trajpred_particle::systematic_indices;
+/// let mut out = [0; 4];
+/// // positions 0.125, 0.375, 0.625, 0.875 against cumulative sums 0.5, 0.75, 1
+/// systematic_indices(&[0.5, 0.25, 0.25], 0.5, &mut out)?;
+/// assert_eq!(out, [0, 0, 1, 2]);
+/// # Ok::<(), trajpred_particle::ParticleError>(())
+/// ```
+pub fn systematic_indices(weights: &[f64], offset: f64, out: &mut [usize]) -> Result<()> {
+    let c = check_weights(weights)?;
+    check_uniform(0, offset)?;
+    let nf = out.len() as f64;
+    let total = c.total;
+    merge_sorted(weights, c.last, out, |j| (j as f64 + offset) / nf * total);
+    Ok(())
+}
+
+/// Stratified resampling for given uniforms `u_j in [0, 1]` (one per output): positions
+/// `(j + u_j) / n`. Errors with [`ParticleError::LengthMismatch`] unless
+/// `uniforms.len() == out.len()`, [`ParticleError::InvalidUniform`] outside `[0, 1]`.
+pub fn stratified_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) -> Result<()> {
+    let c = check_weights(weights)?;
+    if uniforms.len() != out.len() {
+        return Err(ParticleError::LengthMismatch {
+            what: "uniforms vs output",
+            expected: out.len(),
+            got: uniforms.len(),
+        });
+    }
+    for (i, &u) in uniforms.iter().enumerate() {
+        check_uniform(i, u)?;
+    }
+    let nf = out.len() as f64;
+    let total = c.total;
+    merge_sorted(weights, c.last, out, |j| {
+        (j as f64 + uniforms[j]) / nf * total
+    });
+    Ok(())
+}
+
+/// Index `i` with `C_(i-1) <= p < C_i` in a cumulative-sum array, by binary search,
+/// clamped to `last`.
+fn search(cumsum: &[f64], p: f64, last: usize) -> usize {
+    cumsum.partition_point(|&c| c <= p).min(last)
+}
+
+/// Multinomial resampling for given uniforms `u_j in [0, 1]`, one draw per uniform, in the
+/// order of the uniforms (the inverse of the cumulative distribution at each `u_j`; this
+/// function allocates the cumulative sums).
+///
+/// Equal to filterpy's `multinomial_resample` (`searchsorted` on the cumulative sums) except
+/// on exact ties `u_j = C_i`, where filterpy picks `i` and this picks the next particle of
+/// positive weight (so a zero weight is never selected, even for `u = 0`).
+pub fn multinomial_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) -> Result<()> {
+    let c = check_weights(weights)?;
+    if uniforms.len() != out.len() {
+        return Err(ParticleError::LengthMismatch {
+            what: "uniforms vs output",
+            expected: out.len(),
+            got: uniforms.len(),
+        });
+    }
+    let mut cumsum = Vec::with_capacity(weights.len());
+    let mut s = 0.0;
+    for &w in weights {
+        s += w;
+        cumsum.push(s);
+    }
+    for (j, (&u, o)) in uniforms.iter().zip(out.iter_mut()).enumerate() {
+        check_uniform(j, u)?;
+        *o = search(&cumsum, u * c.total, c.last);
+    }
+    Ok(())
+}
+
+/// Residual resampling for given uniforms (allocates the residual cumulative sums): the
+/// first `k = sum_i floor(n w_i)` outputs are the deterministic copies in index order, the
+/// remaining `n - k` outputs are multinomial draws from the residual weights
+/// `n w_i - floor(n w_i)`, one per uniform, in the order of `uniforms[..n - k]`. Returns `k`.
+///
+/// `n = out.len()`; `uniforms` must hold at least `n - k` values (at most `n` are ever
+/// needed). This is the textbook definition; filterpy 2.0.0's `residual_resample` uses the
+/// residuals `w_i - floor(n w_i)` (biased, filterpy issue #290), so its remainder draws
+/// differ whenever some `n w_i >= 1`.
+///
+/// ```
+/// use trajpred_particle::residual_indices;
+/// let mut out = [0; 4];
+/// // n w = [2.4, 1.2, 0.4]: copies [0, 0, 1], residuals [0.4, 0.2, 0.4] / 1,
+/// // one draw at u = 0.7 lands in particle 2 (cumulative residuals 0.4, 0.6, 1.0)
+/// let k = residual_indices(&[0.6, 0.3, 0.1], &[0.7], &mut out)?;
+/// assert_eq!((k, out), (3, [0, 0, 1, 2]));
+/// # Ok::<(), trajpred_particle::ParticleError>(())
+/// ```
+pub fn residual_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) -> Result<usize> {
+    let c = check_weights(weights)?;
+    let n = out.len();
+    let scale = n as f64 / c.total;
+    let k = write_copies(weights, scale, out);
+    let m = n - k;
+    if uniforms.len() < m {
+        return Err(ParticleError::LengthMismatch {
+            what: "uniforms vs remainder draws",
+            expected: m,
+            got: uniforms.len(),
+        });
+    }
+    if m == 0 {
+        return Ok(k);
+    }
+    let mut cumsum = Vec::with_capacity(weights.len());
+    let mut s = 0.0;
+    let mut last = 0;
+    for (i, &w) in weights.iter().enumerate() {
+        let x = w * scale;
+        let r = x - x.floor();
+        if r > 0.0 {
+            last = i;
+        }
+        s += r;
+        cumsum.push(s);
+    }
+    if s <= 0.0 {
+        // every residual rounded to zero: the copies fell short by rounding only; give the
+        // missing places to the largest weight's particle
+        fill_with_largest(weights, &mut out[k..]);
+        return Ok(k);
+    }
+    for (j, (&u, o)) in uniforms.iter().zip(out[k..].iter_mut()).enumerate() {
+        check_uniform(j, u)?;
+        *o = search(&cumsum, u * s, last);
+    }
+    Ok(k)
+}
+
+/// Writes `floor(w_i * scale)` copies of each `i` (at most `out.len()` in total); returns
+/// how many were written.
+#[inline]
+fn write_copies(weights: &[f64], scale: f64, out: &mut [usize]) -> usize {
+    let n = out.len();
+    let mut k = 0usize;
+    for (i, &w) in weights.iter().enumerate() {
+        let copies = (w * scale).floor() as usize;
+        let end = (k + copies).min(n);
+        out[k..end].fill(i);
+        k = end;
+    }
+    k
+}
+
+fn fill_with_largest(weights: &[f64], out: &mut [usize]) {
+    let mut best = 0;
+    for (i, &w) in weights.iter().enumerate() {
+        if w > weights[best] {
+            best = i;
+        }
+    }
+    out.fill(best);
+}
+
+/// Fills `buf` with the bit patterns of `m = buf.len()` sorted uniforms scaled to
+/// `[0, scale)`: `scale * (E_1 + ... + E_j) / (E_1 + ... + E_(m+1))` with `E ~ Exp(1)` i.i.d.
+/// (the joint law of the order statistics of `m` i.i.d. uniforms).
+fn sorted_uniform_bits<R: Rng + ?Sized>(rng: &mut R, buf: &mut [u64], scale: f64) {
+    let mut s = 0.0f64;
+    for b in buf.iter_mut() {
+        let e: f64 = Exp1.sample(rng);
+        s += e;
+        *b = s.to_bits();
+    }
+    let e: f64 = Exp1.sample(rng);
+    let f = scale / (s + e);
+    for b in buf.iter_mut() {
+        *b = (f64::from_bits(*b) * f).to_bits();
+    }
+}
+
+/// Merges sorted uniforms (drawn here) with the cumulative sums of `weights` (scaled to
+/// total `total`), writing into `out`; allocation-free where `usize` holds 64 bits.
+fn sorted_multinomial<R: Rng + ?Sized>(
+    rng: &mut R,
+    weights: impl Fn(usize) -> f64,
+    len: usize,
+    total: f64,
+    last: usize,
+    out: &mut [usize],
+) {
+    if out.is_empty() {
+        return;
+    }
+    if usize::BITS >= 64 {
+        sorted_multinomial_in_place(rng, weights, len, total, last, out);
+        return;
+    }
+    let mut bits = vec![0u64; out.len()];
+    sorted_uniform_bits(rng, &mut bits, total);
+    let mut i = 0usize;
+    let mut c = weights(0);
+    for (o, &b) in out.iter_mut().zip(bits.iter()) {
+        let p = f64::from_bits(b);
+        while p >= c && i < last && i + 1 < len {
+            i += 1;
+            c += weights(i);
+        }
+        *o = i;
+    }
+}
+
+/// [`sorted_multinomial`] holding the positions' bits in the output buffer itself: each
+/// slot is read before the merge overwrites it with its index.
+fn sorted_multinomial_in_place<R: Rng + ?Sized>(
+    rng: &mut R,
+    weights: impl Fn(usize) -> f64,
+    len: usize,
+    total: f64,
+    last: usize,
+    out: &mut [usize],
+) {
+    let mut s = 0.0f64;
+    for o in out.iter_mut() {
+        let e: f64 = Exp1.sample(rng);
+        s += e;
+        *o = s.to_bits() as usize;
+    }
+    let e: f64 = Exp1.sample(rng);
+    let f = total / (s + e);
+    let mut i = 0usize;
+    let mut c = weights(0);
+    for o in out.iter_mut() {
+        let p = f64::from_bits(*o as u64) * f;
+        while p >= c && i < last && i + 1 < len {
+            i += 1;
+            c += weights(i);
+        }
+        *o = i;
+    }
+}
+
+/// Systematic resampling: one uniform offset `u`, positions `(j + u) / n`. The lowest
+/// variance of the four and `O(n + N)`; each count is `floor(n w_i)` or `ceil(n w_i)`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Systematic;
+
+impl Resampler for Systematic {
+    fn resample_into<R: Rng + ?Sized>(
+        &self,
+        weights: &[f64],
+        rng: &mut R,
+        out: &mut [usize],
+    ) -> Result<()> {
+        let u: f64 = rng.random();
+        systematic_indices(weights, u, out)
+    }
+    fn name(&self) -> &'static str {
+        "systematic"
+    }
+}
+
+/// Stratified resampling: positions `(j + u_j) / n` with an independent uniform per
+/// stratum.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Stratified;
+
+impl Resampler for Stratified {
+    fn resample_into<R: Rng + ?Sized>(
+        &self,
+        weights: &[f64],
+        rng: &mut R,
+        out: &mut [usize],
+    ) -> Result<()> {
+        let c = check_weights(weights)?;
+        let nf = out.len() as f64;
+        let total = c.total;
+        merge_sorted(weights, c.last, out, |j| {
+            let u: f64 = rng.random();
+            (j as f64 + u) / nf * total
+        });
+        Ok(())
+    }
+    fn name(&self) -> &'static str {
+        "stratified"
+    }
+}
+
+/// Multinomial resampling: `n` i.i.d. draws from the weights (the indices are returned in
+/// sorted order, drawn as sorted uniforms; the multiset has the multinomial law).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Multinomial;
+
+impl Resampler for Multinomial {
+    fn resample_into<R: Rng + ?Sized>(
+        &self,
+        weights: &[f64],
+        rng: &mut R,
+        out: &mut [usize],
+    ) -> Result<()> {
+        let c = check_weights(weights)?;
+        sorted_multinomial(rng, |i| weights[i], weights.len(), c.total, c.last, out);
+        Ok(())
+    }
+    fn name(&self) -> &'static str {
+        "multinomial"
+    }
+}
+
+/// Residual resampling (the MKPF paper's scheme): `floor(n w_i)` copies of each particle,
+/// then the remaining `n - sum floor(n w_i)` places drawn multinomially from the residual
+/// weights `n w_i - floor(n w_i)`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Residual;
+
+impl Resampler for Residual {
+    fn resample_into<R: Rng + ?Sized>(
+        &self,
+        weights: &[f64],
+        rng: &mut R,
+        out: &mut [usize],
+    ) -> Result<()> {
+        let c = check_weights(weights)?;
+        let n = out.len();
+        let scale = n as f64 / c.total;
+        let k = write_copies(weights, scale, out);
+        if k == n {
+            return Ok(());
+        }
+        let residual = |i: usize| {
+            let x = weights[i] * scale;
+            x - x.floor()
+        };
+        let mut s = 0.0f64;
+        let mut last = 0usize;
+        for i in 0..weights.len() {
+            let r = residual(i);
+            if r > 0.0 {
+                last = i;
+            }
+            s += r;
+        }
+        if s <= 0.0 {
+            fill_with_largest(weights, &mut out[k..]);
+            return Ok(());
+        }
+        sorted_multinomial(rng, residual, weights.len(), s, last, &mut out[k..]);
+        Ok(())
+    }
+    fn name(&self) -> &'static str {
+        "residual"
+    }
+}
+
+/// The four schemes as a configuration value.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Resampling {
+    /// [`Residual`] (the MKPF paper's choice; default).
+    #[default]
+    Residual,
+    /// [`Systematic`].
+    Systematic,
+    /// [`Stratified`].
+    Stratified,
+    /// [`Multinomial`].
+    Multinomial,
+}
+
+impl Resampling {
+    /// Every scheme, for tests and benchmarks that loop over them.
+    pub const ALL: [Resampling; 4] = [
+        Resampling::Residual,
+        Resampling::Systematic,
+        Resampling::Stratified,
+        Resampling::Multinomial,
+    ];
+}
+
+impl Resampler for Resampling {
+    fn resample_into<R: Rng + ?Sized>(
+        &self,
+        weights: &[f64],
+        rng: &mut R,
+        out: &mut [usize],
+    ) -> Result<()> {
+        match self {
+            Resampling::Residual => Residual.resample_into(weights, rng, out),
+            Resampling::Systematic => Systematic.resample_into(weights, rng, out),
+            Resampling::Stratified => Stratified.resample_into(weights, rng, out),
+            Resampling::Multinomial => Multinomial.resample_into(weights, rng, out),
+        }
+    }
+    fn name(&self) -> &'static str {
+        match self {
+            Resampling::Residual => Residual.name(),
+            Resampling::Systematic => Systematic.name(),
+            Resampling::Stratified => Stratified.name(),
+            Resampling::Multinomial => Multinomial.name(),
+        }
+    }
+}

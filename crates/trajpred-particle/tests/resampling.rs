@@ -1,0 +1,352 @@
+//! Resamplers against the numpy/filterpy fixture (exact indices for given uniforms), their
+//! statistical unbiasedness with a fixed seed, the edges, and every error variant.
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde_json::Value;
+use trajpred_particle::{
+    Multinomial, ParticleError, Resampler, Resampling, Residual, Stratified, Systematic,
+    multinomial_indices, residual_indices, stratified_indices, systematic_indices,
+};
+
+fn fixture() -> Value {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/particle/resampling.json"
+    );
+    let text = std::fs::read_to_string(path).expect("fixture present");
+    serde_json::from_str(&text).expect("fixture parses")
+}
+
+fn floats(v: &Value) -> Vec<f64> {
+    v.as_array()
+        .expect("array")
+        .iter()
+        .map(|x| x.as_f64().expect("number"))
+        .collect()
+}
+
+fn indices(v: &Value) -> Vec<usize> {
+    v.as_array()
+        .expect("array")
+        .iter()
+        .map(|x| x.as_u64().expect("index") as usize)
+        .collect()
+}
+
+/// Exact equality: the reference and ours do the same floating-point operations (positions
+/// `(j + u) / N` scaled by the sequential sum of the weights, sequential cumulative sums), so
+/// no tolerance is needed; a mismatch would be a wrong index.
+#[test]
+fn indices_match_the_textbook_reference_for_given_uniforms() {
+    let fx = fixture();
+    for case in fx["cases"].as_array().expect("cases") {
+        let name = case["name"].as_str().expect("name");
+        let w = floats(&case["weights"]);
+        let n = w.len();
+        let mut out = vec![usize::MAX; n];
+
+        systematic_indices(&w, case["offset"].as_f64().expect("offset"), &mut out)
+            .expect("systematic");
+        assert_eq!(out, indices(&case["systematic"]), "systematic, {name}");
+
+        stratified_indices(&w, &floats(&case["stratified_uniforms"]), &mut out)
+            .expect("stratified");
+        assert_eq!(out, indices(&case["stratified"]), "stratified, {name}");
+
+        multinomial_indices(&w, &floats(&case["multinomial_uniforms"]), &mut out)
+            .expect("multinomial");
+        assert_eq!(out, indices(&case["multinomial"]), "multinomial, {name}");
+
+        let k =
+            residual_indices(&w, &floats(&case["residual_uniforms"]), &mut out).expect("residual");
+        assert_eq!(out, indices(&case["residual"]), "residual, {name}");
+        assert_eq!(
+            k as u64,
+            case["residual_copies"].as_u64().expect("k"),
+            "{name}"
+        );
+    }
+}
+
+/// filterpy 2.0.0 gives the same systematic, stratified and multinomial indices on normalised
+/// weights; its systematic resampler raises IndexError at the edge offset where ours
+/// returns valid indices; its residual resampler differs (biased, filterpy #290).
+#[test]
+fn agrees_with_filterpy_where_filterpy_is_right() {
+    let fx = fixture();
+    let mut residual_differs = 0;
+    for case in fx["cases"].as_array().expect("cases") {
+        let name = case["name"].as_str().expect("name");
+        if name == "unnormalised50" {
+            continue; // filterpy assumes normalised weights
+        }
+        if name == "edge_offset" {
+            assert_eq!(case["filterpy_systematic"].as_str(), Some("IndexError"));
+            let w = floats(&case["weights"]);
+            let mut out = vec![usize::MAX; w.len()];
+            systematic_indices(&w, case["offset"].as_f64().expect("u"), &mut out)
+                .expect("no crash at the edge");
+            assert!(out.iter().all(|&i| i < w.len()));
+            assert_eq!(out[w.len() - 1], w.len() - 1);
+            continue;
+        }
+        for scheme in ["systematic", "stratified", "multinomial"] {
+            assert_eq!(
+                indices(&case[format!("filterpy_{scheme}")]),
+                indices(&case[scheme]),
+                "{scheme}, {name}"
+            );
+        }
+        if case["filterpy_residual"] != case["residual"] {
+            residual_differs += 1;
+        }
+    }
+    assert!(residual_differs >= 3, "filterpy's residual bias visible");
+}
+
+#[test]
+fn edge_offsets_never_index_past_the_end() {
+    let just_below_one = f64::from_bits(1.0f64.to_bits() - 1);
+    // weights whose sum rounds below 1, trailing zeros, and a single particle
+    let cases: Vec<Vec<f64>> = vec![
+        vec![0.1; 10],
+        vec![0.3, 0.3, 0.4, 0.0, 0.0],
+        vec![1.0],
+        vec![1e-300, 1.0, 1e-300],
+    ];
+    for w in &cases {
+        let last_positive = w.iter().rposition(|&x| x > 0.0).expect("positive");
+        for &u in &[0.0, just_below_one, 1.0] {
+            for n in [1usize, w.len(), 3 * w.len()] {
+                let mut out = vec![usize::MAX; n];
+                systematic_indices(w, u, &mut out).expect("systematic");
+                assert!(
+                    out.iter().all(|&i| i <= last_positive && w[i] > 0.0),
+                    "{w:?} {u}"
+                );
+                stratified_indices(w, &vec![u; n], &mut out).expect("stratified");
+                assert!(
+                    out.iter().all(|&i| i <= last_positive && w[i] > 0.0),
+                    "{w:?} {u}"
+                );
+                multinomial_indices(w, &vec![u; n], &mut out).expect("multinomial");
+                assert!(
+                    out.iter().all(|&i| i <= last_positive && w[i] > 0.0),
+                    "{w:?} {u}"
+                );
+                residual_indices(w, &vec![u; n], &mut out).expect("residual");
+                assert!(
+                    out.iter().all(|&i| i <= last_positive && w[i] > 0.0),
+                    "{w:?} {u}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn hand_worked_indices() {
+    // N = 4, w = [0.5, 0.25, 0.25]: cumulative 0.5, 0.75, 1.0
+    let w = [0.5, 0.25, 0.25];
+    let mut out = [0; 4];
+    // positions 0, 0.25, 0.5, 0.75: 0.5 is not < 0.5, so it selects 1; 0.75 selects 2
+    systematic_indices(&w, 0.0, &mut out).expect("ok");
+    assert_eq!(out, [0, 0, 1, 2]);
+    // stratified with u = (0.9, 0.1, 0.9, 0.1): positions 0.225, 0.275, 0.725, 0.775
+    stratified_indices(&w, &[0.9, 0.1, 0.9, 0.1], &mut out).expect("ok");
+    assert_eq!(out, [0, 0, 1, 2]);
+    // multinomial keeps the order of the uniforms
+    multinomial_indices(&w, &[0.8, 0.1, 0.6, 0.49], &mut out).expect("ok");
+    assert_eq!(out, [2, 0, 1, 0]);
+    // residual, N = 4, w = [0.6, 0.3, 0.1]: N w = [2.4, 1.2, 0.4] -> copies [0, 0, 1];
+    // residuals [0.4, 0.2, 0.4] (sum 1); u = 0.5 -> position 0.5 in [0.4, 0.6) -> particle 1
+    let k = residual_indices(&[0.6, 0.3, 0.1], &[0.5], &mut out).expect("ok");
+    assert_eq!((k, out), (3, [0, 0, 1, 1]));
+    // unnormalised weights give the same answer as normalised ones
+    systematic_indices(&[2.0, 1.0, 1.0], 0.0, &mut out).expect("ok");
+    assert_eq!(out, [0, 0, 1, 2]);
+}
+
+fn schemes() -> Vec<(&'static str, Resampling)> {
+    Resampling::ALL.iter().map(|r| (r.name(), *r)).collect()
+}
+
+/// Unbiasedness: over R = 20000 seeded repetitions the mean count of particle i is within
+/// 5 standard errors of N w_i. The per-repetition variance of a count is at most the
+/// multinomial N w_i (1 - w_i) for multinomial, stratified and residual resampling, and at
+/// most 1/4 for systematic (counts are floor or ceil of N w_i); the bound uses
+/// max(N w_i (1 - w_i), 1/4) / R. A false alarm at 5 sigma has probability below 1e-6 per
+/// check, and the seed is fixed.
+#[test]
+fn every_resampler_is_unbiased() {
+    let w = [0.02, 0.3, 0.0, 0.155, 0.125, 0.4, 0.0005, 0.0];
+    let total: f64 = w.iter().sum();
+    let n = 9usize; // outputs != inputs on purpose
+    let reps = 20_000;
+    for (name, scheme) in schemes() {
+        let mut rng = ChaCha8Rng::seed_from_u64(42);
+        let mut counts = vec![0u64; w.len()];
+        let mut out = vec![0usize; n];
+        for _ in 0..reps {
+            scheme
+                .resample_into(&w, &mut rng, &mut out)
+                .expect("resample");
+            for &i in &out {
+                counts[i] += 1;
+            }
+        }
+        for (i, &wi) in w.iter().enumerate() {
+            let p = wi / total;
+            let expected = n as f64 * p;
+            let mean = counts[i] as f64 / reps as f64;
+            if wi == 0.0 {
+                assert_eq!(counts[i], 0, "{name}: zero weight {i} selected");
+                continue;
+            }
+            let sd = ((n as f64 * p * (1.0 - p)).max(0.25) / reps as f64).sqrt();
+            assert!(
+                (mean - expected).abs() < 5.0 * sd,
+                "{name}: particle {i} mean count {mean}, expected {expected}, sd {sd}"
+            );
+        }
+    }
+}
+
+#[test]
+fn structural_properties_of_counts() {
+    let w = [0.05, 0.31, 0.14, 0.2, 0.3];
+    let n = 10;
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    for _ in 0..500 {
+        let mut count = |scheme: &dyn Fn(&mut ChaCha8Rng, &mut [usize])| {
+            let mut out = vec![0usize; n];
+            scheme(&mut rng, &mut out);
+            let mut c = vec![0usize; w.len()];
+            for &i in &out {
+                c[i] += 1;
+            }
+            c
+        };
+        let res = count(&|r, o| Residual.resample_into(&w, r, o).expect("ok"));
+        let sys = count(&|r, o| Systematic.resample_into(&w, r, o).expect("ok"));
+        let strat = count(&|r, o| Stratified.resample_into(&w, r, o).expect("ok"));
+        for (i, &wi) in w.iter().enumerate() {
+            let nw = n as f64 * wi;
+            // residual keeps floor(N w_i) copies; systematic gives floor or ceil
+            assert!(
+                res[i] as f64 >= (nw - 1e-9).floor(),
+                "residual {i}: {res:?}"
+            );
+            assert!(
+                (sys[i] as f64 - nw).abs() < 1.0 + 1e-9,
+                "systematic {i}: {sys:?}"
+            );
+            assert!((strat[i] as f64 - nw).abs() < 2.0 + 1e-9, "stratified {i}");
+        }
+        assert_eq!(res.iter().sum::<usize>(), n);
+    }
+}
+
+#[test]
+fn same_seed_same_indices_and_buffer_equals_vector() {
+    let w: Vec<f64> = (0..100).map(|i| ((i * 37 % 11) as f64).powi(2)).collect();
+    for (name, scheme) in schemes() {
+        let a = scheme
+            .resample(&w, 100, &mut ChaCha8Rng::seed_from_u64(5))
+            .expect("a");
+        let mut b = vec![0; 100];
+        scheme
+            .resample_into(&w, &mut ChaCha8Rng::seed_from_u64(5), &mut b)
+            .expect("b");
+        assert_eq!(a, b, "{name}");
+        assert!(a.iter().all(|&i| w[i] > 0.0), "{name}");
+    }
+    // the unit structs and the enum agree
+    let mut r1 = ChaCha8Rng::seed_from_u64(9);
+    let mut r2 = ChaCha8Rng::seed_from_u64(9);
+    assert_eq!(
+        Multinomial.resample(&w, 50, &mut r1).expect("m"),
+        Resampling::Multinomial
+            .resample(&w, 50, &mut r2)
+            .expect("m")
+    );
+}
+
+#[test]
+fn single_particle_and_empty_output() {
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    for (name, scheme) in schemes() {
+        assert_eq!(scheme.resample(&[0.7], 3, &mut rng).expect(name), [0, 0, 0]);
+        assert!(
+            scheme
+                .resample(&[0.2, 0.8], 0, &mut rng)
+                .expect(name)
+                .is_empty()
+        );
+    }
+}
+
+#[test]
+fn bad_weights_are_typed_errors() {
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    for (name, scheme) in schemes() {
+        let mut out = [0usize; 3];
+        assert_eq!(
+            scheme.resample_into(&[], &mut rng, &mut out),
+            Err(ParticleError::Empty { what: "weights" }),
+            "{name}"
+        );
+        assert_eq!(
+            scheme.resample_into(&[0.0, 0.0], &mut rng, &mut out),
+            Err(ParticleError::AllWeightsZero { count: 2 }),
+            "{name}"
+        );
+        assert!(
+            matches!(
+                scheme.resample_into(&[0.5, -0.1], &mut rng, &mut out),
+                Err(ParticleError::InvalidWeight { index: 1, .. })
+            ),
+            "{name}"
+        );
+        assert!(
+            matches!(
+                scheme.resample_into(&[f64::NAN, 1.0], &mut rng, &mut out),
+                Err(ParticleError::InvalidWeight { index: 0, .. })
+            ),
+            "{name}"
+        );
+        assert!(
+            matches!(
+                scheme.resample_into(&[f64::INFINITY], &mut rng, &mut out),
+                Err(ParticleError::InvalidWeight { index: 0, .. })
+            ),
+            "{name}"
+        );
+        assert!(
+            matches!(
+                scheme.resample_into(&[f64::MAX, f64::MAX], &mut rng, &mut out),
+                Err(ParticleError::NonFinite { .. })
+            ),
+            "{name}"
+        );
+    }
+    let mut out = [0usize; 2];
+    assert!(matches!(
+        systematic_indices(&[1.0], 1.5, &mut out),
+        Err(ParticleError::InvalidUniform { index: 0, .. })
+    ));
+    assert!(matches!(
+        stratified_indices(&[1.0], &[0.5], &mut out),
+        Err(ParticleError::LengthMismatch { .. })
+    ));
+    assert!(matches!(
+        multinomial_indices(&[1.0], &[0.5, -0.5], &mut out),
+        Err(ParticleError::InvalidUniform { index: 1, .. })
+    ));
+    // N = 2, w = [0.25, 0.75]: copies [1], one remainder draw needs one uniform
+    assert!(matches!(
+        residual_indices(&[0.25, 0.75], &[], &mut out),
+        Err(ParticleError::LengthMismatch { expected: 1, .. })
+    ));
+}
