@@ -1,0 +1,87 @@
+//! The model file: one file holding a JSON header (configuration, standardisation, training
+//! reports) followed by the networks' weights in burn's record format (burnpack bytes).
+//!
+//! Layout: the magic line `trajpred-neural 1\n`, then little-endian `u64` lengths each
+//! followed by that many bytes: first the JSON header, then one record per network.
+
+use crate::error::{NeuralError, Result};
+use burn::module::Module;
+use burn::store::ModuleRecord;
+use burn::tensor::Bytes;
+use std::path::Path;
+
+const MAGIC: &[u8] = b"trajpred-neural 1\n";
+
+fn perr(path: &Path, reason: impl ToString) -> NeuralError {
+    NeuralError::Persistence {
+        path: path.display().to_string(),
+        reason: reason.to_string(),
+    }
+}
+
+/// Writes the header and the modules' records to `path`.
+pub(crate) fn write<N: Module>(path: &Path, header: &str, nets: &[N]) -> Result<()> {
+    let mut out = Vec::from(MAGIC);
+    let mut push = |bytes: &[u8]| {
+        out.extend_from_slice(&(bytes.len() as u64).to_le_bytes());
+        out.extend_from_slice(bytes);
+    };
+    push(header.as_bytes());
+    for n in nets {
+        let bytes = n
+            .clone()
+            .into_record()
+            .into_bytes()
+            .map_err(|e| perr(path, format!("{e:?}")))?;
+        push(&bytes[..]);
+    }
+    std::fs::write(path, out).map_err(|e| perr(path, e))
+}
+
+/// Reads a file written by [`write`]: the header and the raw records.
+pub(crate) fn read(path: &Path) -> Result<(String, Vec<Vec<u8>>)> {
+    let data = std::fs::read(path).map_err(|e| perr(path, e))?;
+    let rest = data
+        .strip_prefix(MAGIC)
+        .ok_or_else(|| perr(path, "not a trajpred-neural model file"))?;
+    let mut chunks = Vec::new();
+    let mut pos = 0usize;
+    while pos < rest.len() {
+        let len_bytes: [u8; 8] = rest
+            .get(pos..pos + 8)
+            .and_then(|s| s.try_into().ok())
+            .ok_or_else(|| perr(path, "truncated length field"))?;
+        let len = usize::try_from(u64::from_le_bytes(len_bytes))
+            .map_err(|_| perr(path, "length field too large"))?;
+        pos += 8;
+        let end = pos
+            .checked_add(len)
+            .filter(|&e| e <= rest.len())
+            .ok_or_else(|| perr(path, "truncated chunk"))?;
+        chunks.push(rest[pos..end].to_vec());
+        pos = end;
+    }
+    if chunks.is_empty() {
+        return Err(perr(path, "no header"));
+    }
+    let header = String::from_utf8(chunks.remove(0)).map_err(|e| perr(path, e))?;
+    Ok((header, chunks))
+}
+
+/// Loads raw record bytes into a freshly built module.
+pub(crate) fn load_into<N: Module>(path: &Path, net: N, bytes: Vec<u8>) -> Result<N> {
+    let record = ModuleRecord::from_bytes(Bytes::from_bytes_vec(bytes))
+        .map_err(|e| perr(path, format!("{e:?}")))?;
+    net.try_load_record(record)
+        .map_err(|e| perr(path, format!("{e:?}")))
+}
+
+/// Serialises a header.
+pub(crate) fn to_json<T: serde::Serialize>(path: &Path, v: &T) -> Result<String> {
+    serde_json::to_string(v).map_err(|e| perr(path, e))
+}
+
+/// Parses a header.
+pub(crate) fn from_json<T: serde::de::DeserializeOwned>(path: &Path, s: &str) -> Result<T> {
+    serde_json::from_str(s).map_err(|e| perr(path, e))
+}

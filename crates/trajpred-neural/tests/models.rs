@@ -1,0 +1,354 @@
+//! Behaviour of the trained models: the loss falls, runs are reproducible, forecasts are
+//! causal, models save and load, bad input gives typed errors.
+
+use trajpred_core::{Predictor, Trajectory};
+use trajpred_neural::{
+    AxisMode, EarlyStopping, LstmArch, LstmNet, Mlp, MlpArch, NeuralError, RecurrentLayers,
+    RnnArch, RnnNet, TrainConfig, TrainReport, WindowConfig, WindowNet,
+};
+
+/// A small 3-D curve: `n` points of a helix-like path.
+fn curve(n: usize, phase: f64) -> Trajectory {
+    let t: Vec<f64> = (0..n).map(|i| i as f64 * 0.1 + phase).collect();
+    Trajectory::uniform(
+        0.0,
+        0.1,
+        vec![
+            t.iter().map(|s| (0.7 * s).sin()).collect(),
+            t.iter().map(|s| (0.5 * s).cos()).collect(),
+            t.iter().map(|s| 0.3 * s + 0.2 * (1.3 * s).sin()).collect(),
+        ],
+    )
+    .unwrap()
+}
+
+fn small_rec() -> RecurrentLayers {
+    RecurrentLayers {
+        layers: vec![16],
+        fc: vec![16],
+        ..RecurrentLayers::default()
+    }
+}
+
+fn layout(axes: AxisMode) -> WindowConfig {
+    WindowConfig {
+        window: 5,
+        horizon: 2,
+        axes,
+    }
+}
+
+fn falls(report: &TrainReport) {
+    let first = report.first_loss().unwrap();
+    let last = report.last_loss().unwrap();
+    assert!(
+        last < 0.5 * first,
+        "loss did not fall enough: {first} -> {last}"
+    );
+}
+
+#[test]
+fn mlp_loss_falls_per_axis_and_forecasts() {
+    let train = vec![curve(120, 0.0)];
+    let mut m = Mlp::new(
+        MlpArch::default(),
+        layout(AxisMode::PerAxis),
+        TrainConfig::new(1e-2).with_epochs(15).with_seed(3),
+    )
+    .unwrap();
+    let mut seen = 0;
+    let reports = m.fit_with(&train, &mut |_| seen += 1).unwrap().to_vec();
+    assert_eq!(reports.len(), 3, "one network per axis");
+    assert_eq!(seen, 45, "one callback per epoch per network");
+    for r in &reports {
+        falls(r);
+    }
+    let hist = curve(60, 0.0);
+    let f = m.forecast(&hist, 4).unwrap();
+    assert_eq!(f.horizon(), 4);
+    let truth = curve(64, 0.0);
+    let err = (f.step(1)[0] - truth.axis(0)[60]).abs();
+    assert!(err < 0.2, "one-step error {err}");
+}
+
+#[test]
+fn rnn_loss_falls_joint() {
+    let train = vec![curve(100, 0.0), curve(100, 1.0)];
+    let mut m = RnnNet::new(
+        RnnArch(small_rec()),
+        layout(AxisMode::Joint),
+        TrainConfig::new(1e-2).with_epochs(8).with_seed(1),
+    )
+    .unwrap();
+    let r = m.fit_with(&train, &mut |_| {}).unwrap();
+    assert_eq!(r.len(), 1);
+    falls(&r[0]);
+}
+
+#[test]
+fn lstm_loss_falls_joint() {
+    let train = vec![curve(100, 0.0), curve(100, 1.0)];
+    let mut m = LstmNet::new(
+        LstmArch(small_rec()),
+        layout(AxisMode::Joint),
+        TrainConfig::new(1e-2).with_epochs(8).with_seed(1),
+    )
+    .unwrap();
+    let r = m.fit_with(&train, &mut |_| {}).unwrap();
+    falls(&r[0]);
+}
+
+fn lstm_predictions(seed: u64) -> Vec<f64> {
+    let train = vec![curve(60, 0.0)];
+    let mut m = LstmNet::new(
+        LstmArch(small_rec()),
+        layout(AxisMode::Joint),
+        TrainConfig::new(1e-2).with_epochs(2).with_seed(seed),
+    )
+    .unwrap();
+    m.fit(&train).unwrap();
+    let f = m.forecast(&curve(30, 0.5), 3).unwrap();
+    f.points().flat_map(|p| p.to_vec()).collect()
+}
+
+#[test]
+fn same_seed_same_predictions() {
+    let a = lstm_predictions(11);
+    let b = lstm_predictions(11);
+    assert_eq!(a, b, "same seed must reproduce bit for bit");
+    let c = lstm_predictions(12);
+    assert_ne!(a, c, "another seed gives other weights");
+}
+
+#[test]
+fn forecast_is_causal_and_beyond_horizon_recursive() {
+    let mut m = Mlp::new(
+        MlpArch {
+            hidden: vec![8],
+            ..MlpArch::default()
+        },
+        layout(AxisMode::Joint),
+        TrainConfig::new(1e-2).with_epochs(2),
+    )
+    .unwrap();
+    m.fit(&[curve(50, 0.0)]).unwrap();
+    let long = curve(40, 0.0);
+    let f1 = m.forecast(&long.prefix(30).unwrap(), 5).unwrap();
+    // changing every point after the origin does not change the forecast
+    let mut axes: Vec<Vec<f64>> = long.axes().map(<[f64]>::to_vec).collect();
+    for a in &mut axes {
+        for v in &mut a[30..] {
+            *v += 100.0;
+        }
+    }
+    let changed = Trajectory::uniform(0.0, 0.1, axes).unwrap();
+    let f2 = m.forecast(&changed.prefix(30).unwrap(), 5).unwrap();
+    assert_eq!(f1, f2);
+    // horizon 5 > trained T = 2: the first two steps equal the direct output
+    let direct = m.forecast(&long.prefix(30).unwrap(), 2).unwrap();
+    assert_eq!(f1.step(1), direct.step(1));
+    assert_eq!(f1.step(2), direct.step(2));
+}
+
+#[test]
+fn early_stopping_restores_best_and_reports_validation() {
+    let mut m = Mlp::new(
+        MlpArch {
+            hidden: vec![8],
+            ..MlpArch::default()
+        },
+        layout(AxisMode::Joint),
+        TrainConfig::new(5e-2)
+            .with_epochs(200)
+            .with_early_stopping(EarlyStopping {
+                validation_fraction: 0.25,
+                patience: 3,
+                min_delta: 1e-3,
+            }),
+    )
+    .unwrap();
+    let r = m.fit_with(&[curve(80, 0.0)], &mut |_| {}).unwrap()[0].clone();
+    assert!(r.epochs.iter().all(|e| e.validation_loss.is_some()));
+    assert!(r.stopped_early, "stopped after {} epochs", r.epochs.len());
+    let best = r
+        .epochs
+        .iter()
+        .map(|e| e.validation_loss.unwrap())
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(r.epochs[r.best_epoch - 1].validation_loss, Some(best));
+}
+
+#[test]
+fn save_and_load_give_the_same_forecast() {
+    let mut m = RnnNet::new(
+        RnnArch(small_rec()),
+        layout(AxisMode::PerAxis),
+        TrainConfig::new(1e-2).with_epochs(2),
+    )
+    .unwrap();
+    m.fit(&[curve(40, 0.0)]).unwrap();
+    let dir = std::env::temp_dir().join(format!("trajpred-neural-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("rnn.tpnn");
+    m.save(&path).unwrap();
+    let back = RnnNet::load(&path).unwrap();
+    let h = curve(20, 0.3);
+    assert_eq!(m.forecast(&h, 3).unwrap(), back.forecast(&h, 3).unwrap());
+    // a file of another family is refused with a typed error
+    assert!(matches!(
+        LstmNet::load(&path),
+        Err(NeuralError::Persistence { .. })
+    ));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_input_gives_typed_errors() {
+    let cfg = TrainConfig::new(1e-2).with_epochs(1);
+    let mut m = WindowNet::new(MlpArch::default(), layout(AxisMode::Joint), cfg.clone()).unwrap();
+    // not fitted
+    assert!(matches!(
+        m.predict_window(&vec![vec![0.0; 3]; 5]),
+        Err(NeuralError::NotFitted)
+    ));
+    // too short to make one window + horizon
+    assert!(matches!(
+        m.fit_with(&[curve(6, 0.0)], &mut |_| {}),
+        Err(NeuralError::TooShort {
+            needed: 7,
+            got: 6,
+            ..
+        })
+    ));
+    // no data
+    assert!(matches!(
+        m.fit_with(&[], &mut |_| {}),
+        Err(NeuralError::NoTrainingData { .. })
+    ));
+    // mixed dimensions
+    let two_d = Trajectory::uniform(0.0, 1.0, vec![vec![0.0; 20], vec![1.0; 20]]).unwrap();
+    assert!(matches!(
+        m.fit_with(&[curve(20, 0.0), two_d.clone()], &mut |_| {}),
+        Err(NeuralError::DimensionMismatch {
+            expected: 3,
+            got: 2,
+            ..
+        })
+    ));
+    m.fit(&[curve(20, 0.0)]).unwrap();
+    // NaN in a raw window
+    let mut w = vec![vec![0.1, 0.2, 0.3]; 5];
+    w[2][1] = f64::NAN;
+    assert!(matches!(
+        m.predict_window(&w),
+        Err(NeuralError::NonFinite { index: 2, .. })
+    ));
+    // wrong point dimension, wrong window length
+    assert!(matches!(
+        m.predict_window(&vec![vec![0.0; 2]; 5]),
+        Err(NeuralError::DimensionMismatch {
+            expected: 3,
+            got: 2,
+            ..
+        })
+    ));
+    assert!(matches!(
+        m.predict_window(&vec![vec![0.0; 3]; 4]),
+        Err(NeuralError::DimensionMismatch {
+            expected: 5,
+            got: 4,
+            ..
+        })
+    ));
+    // through the Predictor trait: history too short, wrong dimension
+    assert!(matches!(
+        m.forecast(&curve(4, 0.0), 1),
+        Err(trajpred_core::Error::TooShort {
+            needed: 5,
+            got: 4,
+            ..
+        })
+    ));
+    assert!(matches!(
+        m.forecast(&two_d, 1),
+        Err(trajpred_core::Error::DimensionMismatch {
+            expected: 3,
+            got: 2,
+            ..
+        })
+    ));
+    // invalid configurations
+    assert!(matches!(
+        WindowNet::new(
+            MlpArch::default(),
+            layout(AxisMode::Joint),
+            cfg.clone().with_epochs(0)
+        ),
+        Err(NeuralError::InvalidConfig { name: "epochs", .. })
+    ));
+    assert!(matches!(
+        WindowNet::new(
+            MlpArch::default(),
+            WindowConfig {
+                window: 0,
+                horizon: 1,
+                axes: AxisMode::Joint
+            },
+            cfg.clone()
+        ),
+        Err(NeuralError::InvalidConfig { name: "window", .. })
+    ));
+    assert!(matches!(
+        WindowNet::new(
+            LstmArch(RecurrentLayers {
+                layers: vec![],
+                ..RecurrentLayers::default()
+            }),
+            layout(AxisMode::Joint),
+            cfg.clone()
+        ),
+        Err(NeuralError::InvalidConfig { name: "layers", .. })
+    ));
+    assert!(matches!(
+        WindowNet::new(
+            MlpArch::default(),
+            layout(AxisMode::Joint),
+            cfg.with_learning_rate(f64::NAN)
+        ),
+        Err(NeuralError::InvalidConfig {
+            name: "learning_rate",
+            ..
+        })
+    ));
+}
+
+#[test]
+fn divergence_is_an_error_not_a_nan() {
+    let mut m = Mlp::new(
+        MlpArch::default(),
+        layout(AxisMode::Joint),
+        TrainConfig::new(1e6)
+            .with_optimizer(trajpred_neural::Optimizer::SGD)
+            .with_epochs(50),
+    )
+    .unwrap();
+    assert!(matches!(
+        m.fit_with(&[curve(60, 0.0)], &mut |_| {}),
+        Err(NeuralError::Diverged { .. })
+    ));
+}
+
+#[test]
+fn presets_have_the_papers_settings() {
+    let bp = Mlp::gskf_bp(6, 6).unwrap();
+    assert_eq!(bp.train_config().learning_rate, 0.1);
+    assert_eq!(bp.train_config().epochs, 500);
+    assert_eq!(bp.layout().axes, AxisMode::PerAxis);
+    let lstm = LstmNet::gskf_lstm(6, 6).unwrap();
+    assert_eq!(lstm.train_config().epochs, 500);
+    assert_eq!(lstm.arch().0.layers, vec![64, 64]);
+    let rnn = RnnNet::patent_baseline(10, 1).unwrap();
+    assert_eq!(rnn.train_config().learning_rate, 1e-3);
+    let lstm = LstmNet::patent_baseline(10, 1).unwrap();
+    assert_eq!(lstm.train_config().batch_size, 16);
+}
