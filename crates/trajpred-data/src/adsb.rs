@@ -26,7 +26,6 @@ use crate::io::{list, read_all};
 use crate::report::{LoadReport, SkipReason};
 use crate::track::{Cleaner, FrameKind, LoadOptions, RawPoint, Track};
 use serde::de::{self, Deserialize, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
-use serde_json::Value;
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
@@ -226,6 +225,90 @@ impl<'de> Deserialize<'de> for Record {
     }
 }
 
+/// pandas' column-wise layout: one object per column, keyed by row index.
+#[derive(Default)]
+struct Columns {
+    timestamp: Vec<(usize, Num)>,
+    latitude: Vec<(usize, Num)>,
+    longitude: Vec<(usize, Num)>,
+    altitude: Vec<(usize, Num)>,
+    icao24: Vec<(usize, Text)>,
+    callsign: Vec<(usize, Text)>,
+    flight_id: Vec<(usize, Text)>,
+}
+
+/// One column: `{"<row>": value, ...}`; a row key that is not an index fails the document.
+struct Column<T>(Vec<(usize, T)>);
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for Column<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct RowKey(usize);
+        impl<'de> Deserialize<'de> for RowKey {
+            fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                struct V;
+                impl Visitor<'_> for V {
+                    type Value = RowKey;
+                    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                        f.write_str("a row index")
+                    }
+                    fn visit_str<E: de::Error>(self, v: &str) -> Result<RowKey, E> {
+                        v.parse()
+                            .map(RowKey)
+                            .map_err(|_| E::custom(format!("row key {v:?} is not an index")))
+                    }
+                }
+                d.deserialize_str(V)
+            }
+        }
+        struct V<T>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de>> Visitor<'de> for V<T> {
+            type Value = Column<T>;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an object of rows")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut a: A) -> Result<Column<T>, A::Error> {
+                let mut out = Vec::new();
+                while let Some((k, v)) = a.next_entry::<RowKey, T>()? {
+                    out.push((k.0, v));
+                }
+                Ok(Column(out))
+            }
+        }
+        d.deserialize_map(V(std::marker::PhantomData))
+    }
+}
+
+impl<'de> Deserialize<'de> for Columns {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Columns;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an object of columns")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut a: A) -> Result<Columns, A::Error> {
+                let mut c = Columns::default();
+                while let Some(k) = a.next_key::<Key>()? {
+                    match k {
+                        Key::Timestamp => c.timestamp = a.next_value::<Column<Num>>()?.0,
+                        Key::Latitude => c.latitude = a.next_value::<Column<Num>>()?.0,
+                        Key::Longitude => c.longitude = a.next_value::<Column<Num>>()?.0,
+                        Key::Altitude => c.altitude = a.next_value::<Column<Num>>()?.0,
+                        Key::Icao24 => c.icao24 = a.next_value::<Column<Text>>()?.0,
+                        Key::Callsign => c.callsign = a.next_value::<Column<Text>>()?.0,
+                        Key::FlightId => c.flight_id = a.next_value::<Column<Text>>()?.0,
+                        Key::Other => {
+                            a.next_value::<IgnoredAny>()?;
+                        }
+                    }
+                }
+                Ok(c)
+            }
+        }
+        d.deserialize_map(V)
+    }
+}
+
 /// Parses one JSON document (already decompressed) named `file`, adding to `report`.
 /// A document that is not JSON, or neither an array nor an object, is an
 /// [`Error::Parse`]; a record of the wrong shape is skipped as malformed.
@@ -254,55 +337,33 @@ pub fn parse_json(
             }
         }
         Some(b'{') => {
-            let cols: HashMap<String, BTreeMap<String, Value>> =
-                serde_json::from_slice(json).map_err(json_err)?;
+            let cols: Columns = serde_json::from_slice(json).map_err(json_err)?;
             let mut rows: BTreeMap<usize, Record> = BTreeMap::new();
-            let mut bad: BTreeMap<usize, String> = BTreeMap::new();
-            for (name, col) in &cols {
-                for (key, v) in col {
-                    let Ok(row) = key.parse::<usize>() else {
-                        return Err(Error::parse(
-                            file,
-                            1,
-                            format!("column {name:?}: row key {key:?} is not an index"),
-                        ));
-                    };
-                    let r = rows.entry(row).or_default();
-                    let num = |v: &Value| match v {
-                        Value::Null => Ok(None),
-                        Value::Number(n) => Ok(n.as_f64()),
-                        other => Err(format!("{name}: expected a number, got {other}")),
-                    };
-                    let text = |v: &Value| match v {
-                        Value::Null => Ok(None),
-                        Value::String(s) => Ok(Some(s.clone())),
-                        other => Err(format!("{name}: expected a string, got {other}")),
-                    };
-                    let res = match name.as_str() {
-                        "timestamp" => num(v).map(|x| r.timestamp = x),
-                        "latitude" => num(v).map(|x| r.latitude = x),
-                        "longitude" => num(v).map(|x| r.longitude = x),
-                        "altitude" => num(v).map(|x| r.altitude = x),
-                        "icao24" => text(v).map(|x| r.icao24 = x),
-                        "callsign" => text(v).map(|x| r.callsign = x),
-                        "flight_id" => {
-                            r.flight_id = match v {
-                                Value::Null => None,
-                                Value::String(s) => Some(s.clone()),
-                                other => Some(other.to_string()),
-                            };
-                            Ok(())
+            macro_rules! fill {
+                ($col:expr, $field:ident, $name:literal) => {
+                    for (row, v) in $col {
+                        let r = rows.entry(row).or_default();
+                        match v.0 {
+                            Ok(x) => r.$field = x,
+                            Err(e) => {
+                                if r.bad.is_none() {
+                                    r.bad = Some(format!(concat!($name, ": expected {}"), e));
+                                }
+                            }
                         }
-                        _ => Ok(()),
-                    };
-                    if let Err(e) = res {
-                        bad.entry(row).or_insert(e);
                     }
-                }
+                };
             }
-            for (row, r) in rows {
+            fill!(cols.timestamp, timestamp, "timestamp");
+            fill!(cols.latitude, latitude, "latitude");
+            fill!(cols.longitude, longitude, "longitude");
+            fill!(cols.altitude, altitude, "altitude");
+            fill!(cols.icao24, icao24, "icao24");
+            fill!(cols.callsign, callsign, "callsign");
+            fill!(cols.flight_id, flight_id, "flight_id");
+            for (row, mut r) in rows {
                 c.report.records_read += 1;
-                match bad.remove(&row) {
+                match r.bad.take() {
                     Some(e) => c.malformed(row.saturating_add(1), e)?,
                     None => records.push((row.saturating_add(1), r)),
                 }

@@ -271,6 +271,12 @@ fn adsb_bad_documents_are_typed_errors() {
     let t = adsb::parse_json(b"[1, \"a\", null]", "x", &o, &mut r).unwrap();
     assert!(t.is_empty());
     assert_eq!(lines(&r, SkipReason::Malformed), vec![1, 2, 3]);
+    // a column value of the wrong type marks its row (index + 1) malformed
+    let mut r = LoadReport::new();
+    let cols = br#"{"timestamp":{"0":1000,"1":2000},"latitude":{"0":"x","1":1.0},"longitude":{"0":1.0,"1":1.0}}"#;
+    let t = adsb::parse_json(cols, "x", &LoadOptions::default(), &mut r).unwrap();
+    assert_eq!((t.len(), r.records_read), (1, 2));
+    assert_eq!(lines(&r, SkipReason::Malformed), vec![1]);
     let strict = LoadOptions { strict: true, ..o };
     assert!(matches!(
         adsb::parse_json(b"[{}, 1]", "x", &strict, &mut LoadReport::new()),
