@@ -8,7 +8,7 @@ use crate::lars::{Lars, LarsParams};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use trajpred_core::window::hankel_design;
+use trajpred_core::window::{HankelDesign, design_rows, hankel_design};
 
 /// Below this many design entries (rows x m x T) the horizons are fitted one after another:
 /// spawning rayon tasks costs more than it saves.
@@ -61,6 +61,27 @@ impl GscParams {
     /// Errors: [`Error::InvalidParameter`] for `m = 0` or `T = 0`, [`Error::TooShort`],
     /// [`Error::NonFinite`], and the errors of [`LarsParams::fit`].
     pub fn fit(&self, series: &[f64]) -> Result<GroupSparseCoder> {
+        self.fit_many(&[series])
+    }
+
+    /// Fits the `T` horizon models on several series at once (e.g. many trajectories of one
+    /// axis): the Hankel designs of the series are stacked, so no window straddles two series.
+    /// Series too short for any window of a horizon contribute no rows to it. Needs at least
+    /// one series of `m + T + 1` values.
+    ///
+    /// ```
+    /// use trajpred_sparse::GroupSparseCoder;
+    /// let a: Vec<f64> = (0..40).map(|k| (0.3 * k as f64).sin()).collect();
+    /// let b: Vec<f64> = (0..40).map(|k| 2.0 * (0.3 * k as f64 + 1.0).sin()).collect();
+    /// let gsc = GroupSparseCoder::params(3, 2).fit_many(&[&a, &b])?;
+    /// let p = gsc.predict(&b[10..13])?;
+    /// assert!((p[1] - b[14]).abs() < 1e-8); // both obey the same recurrence
+    /// # Ok::<(), trajpred_sparse::Error>(())
+    /// ```
+    ///
+    /// Errors: as [`GscParams::fit`]; `TooShort` names the longest series when none is long
+    /// enough, `NonFinite` gives the series index as `col`.
+    pub fn fit_many(&self, series: &[&[f64]]) -> Result<GroupSparseCoder> {
         let (m, horizons) = (self.window, self.horizons);
         if m == 0 {
             return Err(Error::InvalidParameter {
@@ -75,21 +96,24 @@ impl GscParams {
             });
         }
         let needed = m + horizons + 1;
-        if series.len() < needed {
+        let longest = series.iter().map(|s| s.len()).max().unwrap_or(0);
+        if longest < needed {
             return Err(Error::TooShort {
                 what: "series for group sparse coding",
                 needed,
-                got: series.len(),
+                got: longest,
             });
         }
-        if let Some(row) = series.iter().position(|v| !v.is_finite()) {
-            return Err(Error::NonFinite {
-                what: "series",
-                row,
-                col: 0,
-            });
+        for (col, s) in series.iter().enumerate() {
+            if let Some(row) = s.iter().position(|v| !v.is_finite()) {
+                return Err(Error::NonFinite {
+                    what: "series",
+                    row,
+                    col,
+                });
+            }
         }
-        let work = series.len() * m * horizons;
+        let work = series.iter().map(|s| s.len()).sum::<usize>() * m * horizons;
         let fit_one = |t: usize| self.fit_horizon(series, t);
         let models: Vec<HorizonModel> =
             if self.parallel && horizons > 1 && work >= PARALLEL_MIN_WORK {
@@ -113,11 +137,37 @@ impl GscParams {
         })
     }
 
-    fn fit_horizon(&self, series: &[f64], t: usize) -> Result<HorizonModel> {
-        let d = hankel_design(series, self.window, t).map_err(|e| Error::InvalidParameter {
-            name: "series",
-            reason: e.to_string(),
-        })?;
+    fn fit_horizon(&self, series: &[&[f64]], t: usize) -> Result<HorizonModel> {
+        let mut blocks = Vec::new();
+        for s in series {
+            if design_rows(s.len(), self.window, t).is_some() {
+                blocks.push(hankel_design(s, self.window, t).map_err(|e| {
+                    Error::InvalidParameter {
+                        name: "series",
+                        reason: e.to_string(),
+                    }
+                })?);
+            }
+        }
+        let d = if blocks.len() == 1 {
+            blocks.pop().ok_or(Error::TooShort {
+                what: "series for group sparse coding",
+                needed: self.window + t,
+                got: 0,
+            })?
+        } else {
+            let rows: usize = blocks.iter().map(|b| b.target.len()).sum();
+            let mut design = DMatrix::zeros(rows, self.window);
+            let mut target = DVector::zeros(rows);
+            let mut r = 0;
+            for b in &blocks {
+                let n = b.target.len();
+                design.rows_mut(r, n).copy_from(&b.design);
+                target.rows_mut(r, n).copy_from(&b.target);
+                r += n;
+            }
+            HankelDesign { design, target }
+        };
         let y = d.target.as_slice();
         let rows = y.len() as f64;
         let (coef, intercept, path) = match self.lars.fit(&d.design, y) {
