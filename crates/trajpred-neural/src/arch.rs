@@ -7,7 +7,7 @@
 use crate::config::Activation;
 use crate::error::{NeuralError, Result};
 use burn::module::Module;
-use burn::nn::{Linear, LinearConfig, Lstm, LstmConfig, Rnn, RnnConfig};
+use burn::nn::{Linear, LinearConfig, Rnn, RnnConfig};
 use burn::tensor::activation::{relu, sigmoid, tanh};
 use burn::tensor::{Device, Tensor};
 use serde::{Deserialize, Serialize, de::DeserializeOwned};
@@ -177,8 +177,97 @@ pub struct RnnStack {
 /// Stacked LSTM layers and a head.
 #[derive(Module, Debug)]
 pub struct LstmStack {
-    layers: Vec<Lstm>,
+    layers: Vec<FusedLstm>,
     head: Head,
+}
+
+/// One LSTM layer with the four gates fused into one input and one recurrent matrix
+/// (PyTorch's layout): `[i f g o] = x W_ih + b + h W_hh`,
+/// `c' = sigmoid(f) c + sigmoid(i) tanh(g)`, `h' = sigmoid(o) tanh(c')`.
+///
+/// The same equations as burn's `nn::Lstm`, with fewer tensor operations per step (two
+/// matrix products instead of eight, and the input product of a whole sequence computed at
+/// once), which is what a CPU step costs here.
+#[derive(Module, Debug)]
+pub struct FusedLstm {
+    input: Linear,
+    recurrent: Linear,
+    d_hidden: usize,
+}
+
+/// Cell and hidden state of a [`FusedLstm`], each `[batch, hidden]`.
+#[derive(Debug, Clone)]
+pub struct LstmCellState {
+    /// Cell state `c`.
+    pub cell: Tensor<2>,
+    /// Hidden state `h`.
+    pub hidden: Tensor<2>,
+}
+
+impl FusedLstm {
+    /// A layer from `d_input` features to `d_hidden` units (weights re-initialised later).
+    pub fn new(d_input: usize, d_hidden: usize, device: &Device) -> Self {
+        FusedLstm {
+            input: LinearConfig::new(d_input, 4 * d_hidden).init(device),
+            recurrent: LinearConfig::new(d_hidden, 4 * d_hidden)
+                .with_bias(false)
+                .init(device),
+            d_hidden,
+        }
+    }
+
+    /// One step from the input projection `xw = x W_ih + b` (`[batch, 4 hidden]`).
+    fn step(&self, xw: Tensor<2>, state: Option<LstmCellState>) -> LstmCellState {
+        let gates = match &state {
+            Some(s) => xw + self.recurrent.forward(s.hidden.clone()),
+            None => xw,
+        };
+        let h = self.d_hidden;
+        let i = gates.clone().narrow(1, 0, h);
+        let f = gates.clone().narrow(1, h, h);
+        let c_new = gates.clone().narrow(1, 2 * h, h);
+        let o = gates.narrow(1, 3 * h, h);
+        let ic = sigmoid(i) * tanh(c_new);
+        let cell = match state {
+            Some(s) => sigmoid(f) * s.cell + ic,
+            None => ic,
+        };
+        let hidden = sigmoid(o) * tanh(cell.clone());
+        LstmCellState { cell, hidden }
+    }
+
+    /// One step on input `x: [batch, d_input]`.
+    pub fn forward_step(&self, x: Tensor<2>, state: Option<LstmCellState>) -> LstmCellState {
+        self.step(self.input.forward(x), state)
+    }
+
+    /// Runs over `x: [batch, steps, d_input]`; returns every hidden state
+    /// `[batch, steps, hidden]` and the final state.
+    pub fn forward(
+        &self,
+        x: Tensor<3>,
+        state: Option<LstmCellState>,
+    ) -> (Tensor<3>, LstmCellState) {
+        let [b, m, _] = x.dims();
+        let xw = self.input.forward(x);
+        let h4 = 4 * self.d_hidden;
+        let mut state = state;
+        let mut outs = Vec::with_capacity(m);
+        for t in 0..m {
+            let xt = xw.clone().slice([0..b, t..t + 1, 0..h4]).reshape([b, h4]);
+            let s = self.step(xt, state);
+            outs.push(s.hidden.clone());
+            state = Some(s);
+        }
+        let last = state.unwrap_or_else(|| {
+            let z = Tensor::zeros([b, self.d_hidden], &xw.device());
+            LstmCellState {
+                cell: z.clone(),
+                hidden: z,
+            }
+        });
+        (Tensor::stack(outs, 1), last)
+    }
 }
 
 impl Architecture for RnnArch {
@@ -227,7 +316,7 @@ impl Architecture for LstmArch {
         let mut d = features;
         let mut layers = Vec::new();
         for &h in &self.0.layers {
-            layers.push(LstmConfig::new(d, h, true).init(device));
+            layers.push(FusedLstm::new(d, h, device));
             d = h;
         }
         LstmStack {
@@ -248,5 +337,63 @@ impl Architecture for LstmArch {
             x.slice([0..b, m - 1..m, 0..f]).reshape([b, f])
         });
         net.head.forward(h)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use burn::module::Param;
+    use burn::nn::LstmConfig;
+    use burn::tensor::TensorData;
+
+    /// The fused layer computes exactly what burn's own `nn::Lstm` computes with the same
+    /// weights (an independent implementation of the same equations).
+    #[test]
+    fn fused_lstm_equals_burn_lstm() {
+        let device = Device::flex();
+        let lstm = LstmConfig::new(3, 5, true).init(&device);
+        let forget = lstm.forget_gate.as_ref().expect("uncoupled LSTM");
+        let gates = [&lstm.input_gate, forget, &lstm.cell_gate, &lstm.output_gate];
+        let w_ih = Tensor::cat(
+            gates
+                .iter()
+                .map(|g| g.input_transform.weight.val())
+                .collect(),
+            1,
+        );
+        let w_hh = Tensor::cat(
+            gates
+                .iter()
+                .map(|g| g.hidden_transform.weight.val())
+                .collect(),
+            1,
+        );
+        let bias = |l: &Linear| l.bias.as_ref().expect("bias").val();
+        let b = Tensor::cat(
+            gates
+                .iter()
+                .map(|g| bias(&g.input_transform) + bias(&g.hidden_transform))
+                .collect(),
+            0,
+        );
+        let mut fused = FusedLstm::new(3, 5, &device);
+        fused.input.weight = Param::from_tensor(w_ih);
+        fused.input.bias = Some(Param::from_tensor(b));
+        fused.recurrent.weight = Param::from_tensor(w_hh);
+        let x: Vec<f32> = (0..2 * 4 * 3).map(|i| (i as f32 * 0.37).sin()).collect();
+        let x = Tensor::<3>::from_data(TensorData::new(x, [2, 4, 3]), &device);
+        let (out_a, st_a) = lstm.forward(x.clone(), None);
+        let (out_b, st_b) = fused.forward(x, None);
+        let close = |a: Tensor<3>, b: Tensor<3>| {
+            let a = a.into_data().try_into_vec::<f32>().expect("f32");
+            let b = b.into_data().try_into_vec::<f32>().expect("f32");
+            assert_eq!(a.len(), b.len());
+            for (x, y) in a.iter().zip(&b) {
+                assert!((x - y).abs() < 1e-5, "{x} vs {y}");
+            }
+        };
+        close(out_a, out_b);
+        close(st_a.cell.unsqueeze(), st_b.cell.unsqueeze());
     }
 }

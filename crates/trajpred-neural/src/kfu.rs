@@ -5,7 +5,7 @@
 //! [`kalman_update`] with learnable `Q = exp(log_q)`, `R = exp(log_r)` corrects it with the
 //! observation `z(t)`. The unrolled filter is trained end to end through burn's autodiff.
 
-use crate::arch::Head;
+use crate::arch::{FusedLstm, Head, LstmCellState};
 use crate::config::{Activation, EpochReport, TrainConfig, TrainReport};
 use crate::error::{NeuralError, Result};
 use crate::persist;
@@ -14,7 +14,6 @@ use crate::train::{
 };
 use burn::lr_scheduler::module_lr_scheduler::ModuleLrScheduler;
 use burn::module::{Module, Param, ParamGroup};
-use burn::nn::{Lstm, LstmConfig, LstmState};
 use burn::tensor::{Device, Tensor, TensorData};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -131,7 +130,7 @@ pub struct Noise {
 /// The weights of [`KfuLstmNet`]: the transition network and the noise parameters.
 #[derive(Module, Debug)]
 pub struct KfuCell {
-    lstm: Vec<Lstm>,
+    lstm: Vec<FusedLstm>,
     head: Head,
     /// `log Q` and `log R`.
     pub noise: Noise,
@@ -153,7 +152,7 @@ impl KfuCell {
         let mut lstm = Vec::new();
         let mut h = d;
         for &size in &cfg.layers {
-            lstm.push(LstmConfig::new(h, size, true).init(device));
+            lstm.push(FusedLstm::new(h, size, device));
             h = size;
         }
         KfuCell {
@@ -167,17 +166,14 @@ impl KfuCell {
     }
 
     /// `x + f(x)`, advancing the LSTM states.
-    fn transition(&self, x: Tensor<2>, states: &mut [Option<LstmState<2>>]) -> Tensor<2> {
-        let mut inp = x.clone().unsqueeze_dim::<3>(1);
-        let mut hidden = None;
+    fn transition(&self, x: Tensor<2>, states: &mut [Option<LstmCellState>]) -> Tensor<2> {
+        let mut inp = x.clone();
         for (l, s) in self.lstm.iter().zip(states.iter_mut()) {
-            let (out, ns) = l.forward(inp, s.take());
-            inp = out;
-            hidden = Some(ns.hidden.clone());
+            let ns = l.forward_step(inp, s.take());
+            inp = ns.hidden.clone();
             *s = Some(ns);
         }
-        let h = hidden.unwrap_or_else(|| x.clone());
-        x + self.head.forward(h)
+        x + self.head.forward(inp)
     }
 
     /// Filters `z: [batch, c, d]` from `y(0|0) = z(0)`, `P(0|0) = p0`, and predicts `extra`
@@ -189,7 +185,7 @@ impl KfuCell {
         let r = self.noise.log_r.val().exp().unsqueeze::<2>();
         let mut x = z.clone().slice([0..b, 0..1, 0..d]).reshape([b, d]);
         let mut p = Tensor::<2>::full([b, d], p0, &device);
-        let mut states: Vec<Option<LstmState<2>>> = vec![None; self.lstm.len()];
+        let mut states: Vec<Option<LstmCellState>> = vec![None; self.lstm.len()];
         let mut priors = Vec::with_capacity(c);
         let mut posts = Vec::with_capacity(c);
         for t in 1..c {

@@ -53,7 +53,9 @@ mod persist;
 mod train;
 pub mod window;
 
-pub use arch::{Architecture, LstmArch, MlpArch, RecurrentLayers, RnnArch};
+pub use arch::{
+    Architecture, FusedLstm, LstmArch, LstmCellState, MlpArch, RecurrentLayers, RnnArch,
+};
 pub use config::{
     Activation, AxisMode, EarlyStopping, EpochReport, Optimizer, Progress, TrainConfig, TrainReport,
 };
