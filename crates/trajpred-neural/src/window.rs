@@ -265,11 +265,9 @@ impl<A: Architecture> WindowNet<A> {
                     .collect()
             })
             .collect();
-        let device = device();
         let (f, out) = self.shape(dim);
         let split = self.train.early_stopping.map(|e| e.validation_fraction);
-        let mut nets = Vec::new();
-        let mut reports = Vec::new();
+        let mut jobs = Vec::new();
         for net_index in 0..self.n_nets(dim) {
             let mut tr = Samples::new(m, f, out);
             let mut va = Samples::new(m, f, out);
@@ -303,34 +301,51 @@ impl<A: Architecture> WindowNet<A> {
                     }
                 }
             }
-            let net = self.build_net(dim, &device, 2 * net_index as u64);
-            let arch = &self.arch;
-            let dev = &device;
-            let tr_ref = &tr;
-            let batch_loss = move |n: &A::Net, idx: &[usize]| {
-                let (x, y) = tr_ref.batch(idx, dev);
-                mse(arch.forward(n, x), y)
-            };
-            let va_ref = &va;
-            let validation_loss = move |n: &A::Net| -> Result<f64> {
-                let mut total = 0.0;
-                let all: Vec<usize> = (0..va_ref.n).collect();
-                for idx in all.chunks(256) {
-                    let (x, y) = va_ref.batch(idx, dev);
-                    let l = crate::train::read_scalar(mse(arch.forward(n, x), y))?;
-                    total += l * idx.len() as f64;
+            jobs.push((net_index, tr, va));
+        }
+        let this = &*self;
+        let results: Vec<Result<(A::Net, TrainReport)>> = if jobs.len() == 1 {
+            jobs.into_iter()
+                .map(|(i, tr, va)| this.train_one(dim, i, &tr, &va, progress))
+                .collect()
+        } else {
+            // one thread per axis network (flex runs each op on one core); reports are
+            // forwarded to the caller's callback on this thread, in arrival order
+            std::thread::scope(|scope| {
+                let (tx, rx) = std::sync::mpsc::channel::<EpochReport>();
+                let handles: Vec<_> = jobs
+                    .into_iter()
+                    .map(|(i, tr, va)| {
+                        let tx = tx.clone();
+                        scope.spawn(move || {
+                            this.train_one(dim, i, &tr, &va, &mut |r| {
+                                // the receiver lives until every thread is joined
+                                let _ = tx.send(r.clone());
+                            })
+                        })
+                    })
+                    .collect();
+                drop(tx);
+                for r in rx {
+                    progress(&r);
                 }
-                Ok(total / va_ref.n.max(1) as f64)
-            };
-            let spec = LoopSpec {
-                n_train: tr.n,
-                batch_loss: &batch_loss,
-                validation_loss: (va.n > 0)
-                    .then_some(&validation_loss as &dyn Fn(&A::Net) -> Result<f64>),
-                lr: ModuleLrScheduler::new(self.train.learning_rate),
-            };
-            let (net, report) = train_loop(net, spec, &self.train, net_index, progress)?;
-            nets.push(net.valid());
+                handles
+                    .into_iter()
+                    .map(|h| {
+                        h.join().unwrap_or_else(|_| {
+                            Err(NeuralError::Tensor {
+                                reason: "training thread panicked".into(),
+                            })
+                        })
+                    })
+                    .collect()
+            })
+        };
+        let mut nets = Vec::new();
+        let mut reports = Vec::new();
+        for r in results {
+            let (net, report) = r?;
+            nets.push(net);
             reports.push(report);
         }
         self.fitted = Some(Fitted {
@@ -340,6 +355,45 @@ impl<A: Architecture> WindowNet<A> {
             reports,
         });
         Ok(self.reports().unwrap_or(&[]))
+    }
+
+    /// Trains network `net_index` on its samples (with validation samples `va`, possibly
+    /// empty); returns the network ready for inference.
+    fn train_one(
+        &self,
+        dim: usize,
+        net_index: usize,
+        tr: &Samples,
+        va: &Samples,
+        progress: &mut dyn FnMut(&EpochReport),
+    ) -> Result<(A::Net, TrainReport)> {
+        let device = device();
+        let net = self.build_net(dim, &device, 2 * net_index as u64);
+        let arch = &self.arch;
+        let dev = &device;
+        let batch_loss = move |n: &A::Net, idx: &[usize]| {
+            let (x, y) = tr.batch(idx, dev);
+            mse(arch.forward(n, x), y)
+        };
+        let validation_loss = move |n: &A::Net| -> Result<f64> {
+            let mut total = 0.0;
+            let all: Vec<usize> = (0..va.n).collect();
+            for idx in all.chunks(256) {
+                let (x, y) = va.batch(idx, dev);
+                let l = crate::train::read_scalar(mse(arch.forward(n, x), y))?;
+                total += l * idx.len() as f64;
+            }
+            Ok(total / va.n.max(1) as f64)
+        };
+        let spec = LoopSpec {
+            n_train: tr.n,
+            batch_loss: &batch_loss,
+            validation_loss: (va.n > 0)
+                .then_some(&validation_loss as &dyn Fn(&A::Net) -> Result<f64>),
+            lr: ModuleLrScheduler::new(self.train.learning_rate),
+        };
+        let (net, report) = train_loop(net, spec, &self.train, net_index, progress)?;
+        Ok((net.valid(), report))
     }
 
     fn nets(&self) -> Result<FittedNets<'_, A::Net>> {

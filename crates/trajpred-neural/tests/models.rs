@@ -352,3 +352,32 @@ fn presets_have_the_papers_settings() {
     let lstm = LstmNet::patent_baseline(10, 1).unwrap();
     assert_eq!(lstm.train_config().batch_size, 16);
 }
+
+#[test]
+fn per_axis_networks_train_in_parallel_and_reproducibly() {
+    let run = || {
+        let mut m = Mlp::new(
+            MlpArch {
+                hidden: vec![8],
+                ..MlpArch::default()
+            },
+            layout(AxisMode::PerAxis),
+            TrainConfig::new(1e-2).with_epochs(3).with_seed(4),
+        )
+        .unwrap();
+        let mut seen = Vec::new();
+        m.fit_with(&[curve(50, 0.0)], &mut |e| seen.push((e.network, e.epoch)))
+            .unwrap();
+        seen.sort_unstable();
+        let f = m.forecast(&curve(20, 0.2), 2).unwrap();
+        (seen, f)
+    };
+    let (seen, a) = run();
+    let expected: Vec<(usize, usize)> = (0..3).flat_map(|n| (1..=3).map(move |e| (n, e))).collect();
+    assert_eq!(
+        seen, expected,
+        "every epoch of every axis network is reported"
+    );
+    let (_, b) = run();
+    assert_eq!(a, b);
+}
