@@ -43,6 +43,13 @@ pub enum Error {
         /// Number of columns.
         columns: usize,
     },
+    /// The squared norm of a design column overflows `f64` (values around 1e154 or larger):
+    /// rescale the data.
+    #[error("column {col} of the design is too large: its squared norm overflows")]
+    Overflow {
+        /// Column index.
+        col: usize,
+    },
     /// A parameter outside its valid domain.
     #[error("invalid parameter `{name}`: {reason}")]
     InvalidParameter {

@@ -275,19 +275,28 @@ impl LarsParams {
         let nf = n as f64;
         let mut x_mean = vec![0.0; p];
         let mut x_scale = vec![1.0; p];
-        let mut xs = x.clone();
+        // without centring or scaling the design is used as given (no copy)
+        let mut owned = (self.fit_intercept || self.normalize).then(|| x.clone());
         let mut excluded = Vec::new();
         for j in 0..p {
             let raw_norm = x.column(j).norm();
-            if self.fit_intercept {
-                x_mean[j] = x.column(j).sum() / nf;
-                let m = x_mean[j];
-                xs.column_mut(j).iter_mut().for_each(|v| *v -= m);
+            if !raw_norm.is_finite() {
+                return Err(Error::Overflow { col: j });
             }
-            let norm = xs.column(j).norm();
+            let mut norm = raw_norm;
+            if let Some(xs) = owned.as_mut() {
+                if self.fit_intercept {
+                    x_mean[j] = x.column(j).sum() / nf;
+                    let m = x_mean[j];
+                    xs.column_mut(j).iter_mut().for_each(|v| *v -= m);
+                }
+                norm = xs.column(j).norm();
+            }
             // a constant column leaves only rounding (~ n eps |x|) after centring
-            if raw_norm == 0.0 || norm <= 1e-10 * raw_norm || !norm.is_finite() {
-                xs.column_mut(j).fill(0.0);
+            if raw_norm == 0.0 || norm <= 1e-10 * raw_norm {
+                if let Some(xs) = owned.as_mut() {
+                    xs.column_mut(j).fill(0.0);
+                }
                 x_scale[j] = 1.0;
                 excluded.push(Exclusion {
                     feature: j,
@@ -296,11 +305,14 @@ impl LarsParams {
                 });
                 continue;
             }
-            if self.normalize {
+            if self.normalize
+                && let Some(xs) = owned.as_mut()
+            {
                 x_scale[j] = norm;
                 xs.column_mut(j).iter_mut().for_each(|v| *v /= norm);
             }
         }
+        let xs: &DMatrix<f64> = owned.as_ref().unwrap_or(x);
         if excluded.len() == p {
             return Err(Error::AllColumnsConstant { columns: p });
         }
@@ -320,7 +332,7 @@ impl LarsParams {
         for e in &excluded {
             eligible[e.feature] = false;
         }
-        let core = Core::new(&xs, use_gram);
+        let core = Core::new(xs, use_gram);
         let mut path = core.run(self, &ys, eligible, &mut excluded);
         if matches!(
             path.stop,

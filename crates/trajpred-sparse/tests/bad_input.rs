@@ -195,3 +195,13 @@ fn max_steps_zero_and_alpha_min_above_the_start() {
     assert_eq!(fit.stop_reason(), StopReason::AlphaMin);
     assert!(fit.coef().iter().all(|&v| v == 0.0));
 }
+
+#[test]
+fn overflowing_column_is_reported() {
+    let (mut x, y) = small();
+    x[(2, 2)] = 1e200;
+    assert_eq!(
+        Lars::params().fit(&x, &y).unwrap_err(),
+        Error::Overflow { col: 2 }
+    );
+}
