@@ -19,8 +19,8 @@ use rayon::prelude::*;
 use std::marker::PhantomData;
 use trajpred_core::Gaussian;
 use trajpred_kalman::{
-    Ekf, Filter, KalmanError, MerweSigmaPoints, Observation, ObservationJacobian,
-    TransitionJacobian, Ukf,
+    AugmentedUkf, Ekf, Filter, KalmanError, MerweSigmaPoints, NoisyObservation, NoisyTransition,
+    Observation, ObservationJacobian, TransitionJacobian, Ukf,
 };
 
 /// How the EKF step of the MKPF proposal uses the UKF step's result (SPEC C.1 leaves it
@@ -58,6 +58,27 @@ pub enum ParticlePrior {
     /// approximates the optimal proposal `p(x_k | x_(k-1)^i, z_k)`. The covariance each
     /// particle carries is then its last proposal covariance, reported but not fed back.
     Conditioned,
+}
+
+/// Which UKF of the Kalman crate runs the UKF stage of the proposal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum UkfVariant {
+    /// Default: the augmented UKF of the paper (eq. 12-19, `trajpred_kalman::AugmentedUkf`):
+    /// sigma points of `N([x; 0; 0], blockdiag(P, Q, R))`, propagated through `f(x, w)` and
+    /// `h(f(x, w), v)`, the update from the same points. Used with [`ParticlePrior::Carried`];
+    /// with [`ParticlePrior::Conditioned`] the prior covariance is zero, so the update is the
+    /// additive one.
+    #[default]
+    Augmented,
+    /// The additive-noise UKF (`trajpred_kalman::Ukf`): `Q` and `R` added to the spreads,
+    /// the update's sigma points redrawn from the prediction.
+    Additive,
+}
+
+/// The UKF stage for one step: both filters share the models by reference.
+struct UkfStage<'a, T, Tr, Ob> {
+    additive: Ukf<T, &'a Tr, &'a Ob>,
+    augmented: Option<AugmentedUkf<T, &'a Tr, &'a Ob>>,
 }
 
 /// `h` linearised at a point `a`: `h(a) + H(a) (x - a)`, with `h`'s residual, noise and
@@ -181,6 +202,7 @@ where
     points: MerweSigmaPoints<T>,
     stage: EkfStage,
     prior_mode: ParticlePrior,
+    ukf_variant: UkfVariant,
     cloud: ParticleCloud<T, D>,
     covariances: Vec<OMatrix<T, D, D>>,
     config: PfConfig,
@@ -206,8 +228,8 @@ where
     T: RealField + Copy,
     D: Dim,
     M: Dim,
-    Tr: TransitionJacobian<T, D> + Sync,
-    Ob: ObservationJacobian<T, D, M> + Sync,
+    Tr: TransitionJacobian<T, D> + NoisyTransition<T, D> + Sync,
+    Ob: ObservationJacobian<T, D, M> + NoisyObservation<T, D, M> + Sync,
     DefaultAllocator: Allocator<D>
         + Allocator<D, D>
         + Allocator<M>
@@ -259,6 +281,7 @@ where
             points,
             stage: EkfStage::default(),
             prior_mode: ParticlePrior::default(),
+            ukf_variant: UkfVariant::default(),
             cloud,
             covariances,
             config: PfConfig::default(),
@@ -313,6 +336,34 @@ where
         self.prior_mode
     }
 
+    /// Selects the UKF of the UKF stage.
+    pub fn with_ukf_variant(mut self, variant: UkfVariant) -> Self {
+        self.ukf_variant = variant;
+        self
+    }
+
+    /// The UKF of the UKF stage.
+    pub fn ukf_variant(&self) -> UkfVariant {
+        self.ukf_variant
+    }
+
+    /// The UKF filters of one step.
+    fn ukf_stage(&self) -> Result<UkfStage<'_, T, Tr, Ob>> {
+        let additive = Ukf::new(&self.transition, &self.observation, self.points)?;
+        let augmented = match (self.ukf_variant, self.prior_mode) {
+            (UkfVariant::Augmented, ParticlePrior::Carried) => Some(AugmentedUkf::new(
+                &self.transition,
+                &self.observation,
+                self.points,
+            )?),
+            _ => None,
+        };
+        Ok(UkfStage {
+            additive,
+            augmented,
+        })
+    }
+
     /// The resampling configuration.
     pub fn config(&self) -> &PfConfig {
         &self.config
@@ -331,11 +382,14 @@ where
     /// The UKF prediction of one particle by [`ParticlePrior`].
     fn ukf_prediction(
         &self,
-        ukf: &Ukf<T, &Tr, &Ob>,
+        ukf: &UkfStage<'_, T, Tr, Ob>,
         prior: &Gaussian<T, D>,
     ) -> trajpred_kalman::Result<Gaussian<T, D>> {
         match self.prior_mode {
-            ParticlePrior::Carried => ukf.predict(prior),
+            ParticlePrior::Carried => match &ukf.augmented {
+                Some(a) => a.predict(prior),
+                None => ukf.additive.predict(prior),
+            },
             ParticlePrior::Conditioned => Ok(Gaussian {
                 mean: self.transition.transition(&prior.mean)?,
                 covariance: self.transition.process_noise().clone(),
@@ -346,12 +400,22 @@ where
     /// The Gaussian proposal `q = N(x_bar, P)` of one particle (UKF step, then EKF step).
     fn proposal(
         &self,
-        ukf: &Ukf<T, &Tr, &Ob>,
+        ukf: &UkfStage<'_, T, Tr, Ob>,
         prior: &Gaussian<T, D>,
         z: &OVector<T, M>,
     ) -> trajpred_kalman::Result<(Gaussian<T, D>, Gaussian<T, D>)> {
-        let pred = self.ukf_prediction(ukf, prior)?;
-        let ukf_post = ukf.update(&pred, z)?.posterior;
+        let (pred, ukf_post) = match (&ukf.augmented, self.prior_mode) {
+            (Some(a), ParticlePrior::Carried) => {
+                let step = a.step(prior, Some(z))?;
+                let post = step.posterior().clone();
+                (step.prior, post)
+            }
+            _ => {
+                let pred = self.ukf_prediction(ukf, prior)?;
+                let post = ukf.additive.update(&pred, z)?.posterior;
+                (pred, post)
+            }
+        };
         let q = match self.stage {
             EkfStage::UkfOnly => ukf_post,
             EkfStage::Sequential => {
@@ -376,7 +440,7 @@ where
     /// fallback to the transition prior.
     fn move_particle(
         &self,
-        ukf: &Ukf<T, &Tr, &Ob>,
+        ukf: &UkfStage<'_, T, Tr, Ob>,
         x: &OVector<T, D>,
         p: &OMatrix<T, D, D>,
         e: &[T],
@@ -388,8 +452,8 @@ where
         };
         let Some(z) = z else {
             let xn = propagate_one(&self.transition, &self.q_factor, x, e)?;
-            let pn = ukf
-                .predict(&prior)
+            let pn = self
+                .ukf_prediction(ukf, &prior)
                 .map_or_else(|_| p.clone(), |g| g.covariance);
             return Ok(Moved {
                 x: xn,
@@ -416,7 +480,7 @@ where
     /// The MKPF proposal draw; `Ok(None)` or `Err` asks for the fallback.
     fn propose(
         &self,
-        ukf: &Ukf<T, &Tr, &Ob>,
+        ukf: &UkfStage<'_, T, Tr, Ob>,
         prior: &Gaussian<T, D>,
         z: &OVector<T, M>,
         e: &[T],
@@ -459,8 +523,8 @@ where
     T: RealField + Copy,
     D: Dim,
     M: Dim,
-    Tr: TransitionJacobian<T, D> + Sync,
-    Ob: ObservationJacobian<T, D, M> + Sync,
+    Tr: TransitionJacobian<T, D> + NoisyTransition<T, D> + Sync,
+    Ob: ObservationJacobian<T, D, M> + NoisyObservation<T, D, M> + Sync,
     DefaultAllocator: Allocator<D>
         + Allocator<D, D>
         + Allocator<M>
@@ -484,8 +548,8 @@ where
         let count = self.cloud.len();
         let mut noise: Vec<T> = Vec::new();
         push_normals(rng, count * n, &mut noise);
-        let ukf = Ukf::new(&self.transition, &self.observation, self.points)?;
         let this = &*self;
+        let ukf = this.ukf_stage()?;
         let moved: Vec<Moved<T, D>> = this
             .cloud
             .particles()

@@ -16,7 +16,7 @@ use trajpred_kalman::{
 };
 use trajpred_particle::{
     EkfStage, Mkpf, ParticleCloud, ParticleError, ParticleFilter, ParticleFiltering, ParticlePrior,
-    PfConfig, ResamplePolicy, Resampling,
+    PfConfig, ResamplePolicy, Resampling, UkfVariant,
 };
 
 fn normal(rng: &mut ChaCha8Rng) -> f64 {
@@ -156,12 +156,13 @@ fn position_sq_errors(means: &[Vector5<f64>], truth: &[Vector5<f64>]) -> f64 {
 #[test]
 fn mkpf_beats_bootstrap_with_few_particles_on_coordinated_turn_range_bearing() {
     let n = 20;
-    let (mut sq_carried, mut sq_conditioned, mut sq_boot, mut sq_ukf, mut count) =
+    let (mut sq_carried, mut sq_additive, mut sq_conditioned, mut sq_boot, mut sq_ukf) =
         (0.0, 0.0, 0.0, 0.0, 0.0);
+    let mut count = 0.0;
     for seed in 0..3 {
         let t = track(seed, 30);
         let mut rng = ChaCha8Rng::seed_from_u64(100 + seed);
-        let run_mkpf = |prior: ParticlePrior, rng: &mut ChaCha8Rng| {
+        let run_mkpf = |prior: ParticlePrior, variant: UkfVariant, rng: &mut ChaCha8Rng| {
             let mut m = Mkpf::<f64, U5, U2, _, _>::from_gaussian(
                 t.ct.clone(),
                 t.rb.clone(),
@@ -171,7 +172,8 @@ fn mkpf_beats_bootstrap_with_few_particles_on_coordinated_turn_range_bearing() {
                 rng,
             )
             .expect("mkpf")
-            .with_particle_prior(prior);
+            .with_particle_prior(prior)
+            .with_ukf_variant(variant);
             let steps = m.filter(&t.zs, rng).expect("mkpf filter");
             assert!(
                 steps
@@ -180,9 +182,12 @@ fn mkpf_beats_bootstrap_with_few_particles_on_coordinated_turn_range_bearing() {
             );
             steps.iter().map(|s| s.estimate.mean).collect::<Vec<_>>()
         };
-        sq_carried += position_sq_errors(&run_mkpf(ParticlePrior::Carried, &mut rng), &t.truth);
-        sq_conditioned +=
-            position_sq_errors(&run_mkpf(ParticlePrior::Conditioned, &mut rng), &t.truth);
+        let carried = run_mkpf(ParticlePrior::Carried, UkfVariant::Augmented, &mut rng);
+        sq_carried += position_sq_errors(&carried, &t.truth);
+        let additive = run_mkpf(ParticlePrior::Carried, UkfVariant::Additive, &mut rng);
+        sq_additive += position_sq_errors(&additive, &t.truth);
+        let conditioned = run_mkpf(ParticlePrior::Conditioned, UkfVariant::Additive, &mut rng);
+        sq_conditioned += position_sq_errors(&conditioned, &t.truth);
         let mut pf = ParticleFilter::<f64, U5, U2, _, _>::from_gaussian(
             t.ct.clone(),
             t.rb.clone(),
@@ -209,21 +214,23 @@ fn mkpf_beats_bootstrap_with_few_particles_on_coordinated_turn_range_bearing() {
         count += t.truth.len() as f64;
     }
     let rmse = |s: f64| (s / count).sqrt();
-    let (carried, conditioned, boot, ukf) = (
+    let (carried, additive, conditioned, boot, ukf) = (
         rmse(sq_carried),
+        rmse(sq_additive),
         rmse(sq_conditioned),
         rmse(sq_boot),
         rmse(sq_ukf),
     );
     eprintln!(
-        "position RMSE, N = {n}: MKPF (carried P) {carried:.3} m, MKPF (conditioned) {conditioned:.3} m, bootstrap PF {boot:.3} m, UKF {ukf:.3} m"
+        "position RMSE, N = {n}: MKPF default (carried P, augmented UKF) {carried:.3} m, MKPF (carried P, additive UKF) {additive:.3} m, MKPF (conditioned) {conditioned:.3} m, bootstrap PF {boot:.3} m, UKF {ukf:.3} m"
     );
     assert!(carried < boot, "MKPF {carried} vs bootstrap {boot}");
+    assert!(additive < boot, "MKPF {additive} vs bootstrap {boot}");
     assert!(conditioned < boot, "MKPF {conditioned} vs bootstrap {boot}");
     // the observation's own accuracy is about 1.4 m per axis at this range
     assert!(
-        carried < 5.0 && conditioned < 5.0,
-        "{carried} {conditioned}"
+        carried < 5.0 && additive < 5.0 && conditioned < 5.0,
+        "{carried} {additive} {conditioned}"
     );
 }
 
