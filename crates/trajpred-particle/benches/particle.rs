@@ -1,7 +1,9 @@
 //! Criterion benchmarks of the hot paths:
 //!
 //! - `resample/<scheme>/<N>`: each resampler at N = 10^4 and 10^6 (throughput in particles
-//!   per second; weights i.i.d. uniform, a seeded `SmallRng` (xoshiro256++) as generator);
+//!   per second; weights i.i.d. uniform, a seeded `SmallRng` (xoshiro256++) as generator),
+//!   beside `resample/baseline_sum/<N>`, one pass summing the weights, to calibrate the
+//!   figures on a shared machine;
 //!   filterpy's figures for the same sizes come from `benches/filterpy_resampling.py`;
 //! - `step/bootstrap_ct5_rb2/1000` and `step/mkpf_ct5_rb2/100`: one filter step on the
 //!   coordinated-turn + range-bearing model (throughput: particles per second, so the time
@@ -23,6 +25,11 @@ fn resamplers(c: &mut Criterion) {
         let weights: Vec<f64> = (0..n).map(|_| wrng.random::<f64>()).collect();
         let mut out = vec![0usize; n];
         group.throughput(Throughput::Elements(n as u64));
+        // calibration on a shared machine: one pass summing the weights (a lower bound for
+        // any resampler, which must at least read them)
+        group.bench_with_input(BenchmarkId::new("baseline_sum", n), &n, |b, _| {
+            b.iter(|| black_box(black_box(&weights).iter().sum::<f64>()))
+        });
         for scheme in Resampling::ALL {
             let mut rng = SmallRng::seed_from_u64(2);
             group.bench_with_input(BenchmarkId::new(scheme.name(), n), &n, |b, _| {

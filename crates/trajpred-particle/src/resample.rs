@@ -281,8 +281,9 @@ fn write_copies(weights: &[f64], scale: f64, out: &mut [usize]) -> usize {
     let n = out.len();
     let mut k = 0usize;
     for (i, &w) in weights.iter().enumerate() {
-        let copies = (w * scale).floor() as usize;
-        let end = (k + copies).min(n);
+        // truncation is floor for x >= 0 (and one instruction, unlike `floor` without SSE4.1)
+        let copies = (w * scale) as usize;
+        let end = k.saturating_add(copies).min(n);
         out[k..end].fill(i);
         k = end;
     }
@@ -466,7 +467,7 @@ impl Resampler for Residual {
         }
         let residual = |i: usize| {
             let x = weights[i] * scale;
-            x - x.floor()
+            x - (x as u64) as f64
         };
         let mut s = 0.0f64;
         let mut last = 0usize;
