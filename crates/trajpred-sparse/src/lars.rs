@@ -254,14 +254,23 @@ impl LarsParams {
                 got: y.len(),
             });
         }
+        // one pass per column: a NaN or infinity makes the squared norm non-finite, and only
+        // then is the offending entry located
+        let mut raw_norms = Vec::with_capacity(p);
         for j in 0..p {
-            if let Some(row) = x.column(j).iter().position(|v| !v.is_finite()) {
-                return Err(Error::NonFinite {
-                    what: "design",
-                    row,
-                    col: j,
-                });
+            let col = x.column(j);
+            let sq = crate::cholesky::dot(col.as_slice(), col.as_slice());
+            if !sq.is_finite() {
+                if let Some(row) = col.iter().position(|v| !v.is_finite()) {
+                    return Err(Error::NonFinite {
+                        what: "design",
+                        row,
+                        col: j,
+                    });
+                }
+                return Err(Error::Overflow { col: j });
             }
+            raw_norms.push(sq.sqrt());
         }
         if let Some(row) = y.iter().position(|v| !v.is_finite()) {
             return Err(Error::NonFinite {
@@ -279,10 +288,7 @@ impl LarsParams {
         let mut owned = (self.fit_intercept || self.normalize).then(|| x.clone());
         let mut excluded = Vec::new();
         for j in 0..p {
-            let raw_norm = x.column(j).norm();
-            if !raw_norm.is_finite() {
-                return Err(Error::Overflow { col: j });
-            }
+            let raw_norm = raw_norms[j];
             let mut norm = raw_norm;
             if let Some(xs) = owned.as_mut() {
                 if self.fit_intercept {
