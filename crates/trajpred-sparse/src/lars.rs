@@ -553,6 +553,31 @@ struct Path {
     chol: CholeskyFactor,
 }
 
+/// `X^T X` through nalgebra's blocked gemm (matrixmultiply; `tr_mul` computes one dot product
+/// per entry and is ~15x slower on 5000 x 500), by column blocks so that only the upper block
+/// triangle is multiplied (about 56% of the full product's flops with 8 blocks, used from p = 256 on; smaller
+/// blocks run below gemm's efficient size), then mirrored.
+fn gram_matrix(xs: &DMatrix<f64>) -> DMatrix<f64> {
+    let p = xs.ncols();
+    let blocks = if p >= 256 { 8 } else { 1 };
+    let width = p.div_ceil(blocks);
+    let mut g = DMatrix::zeros(p, p);
+    let mut j0 = 0;
+    while j0 < p {
+        let w = width.min(p - j0);
+        let block_t = xs.columns(j0, w).transpose();
+        let upper = &block_t * xs.columns(j0, p - j0);
+        g.view_mut((j0, j0), (w, p - j0)).copy_from(&upper);
+        j0 += w;
+    }
+    for j in 0..p {
+        for i in (j + 1)..p {
+            g[(i, j)] = g[(j, i)];
+        }
+    }
+    g
+}
+
 struct Core<'a> {
     xs: &'a DMatrix<f64>,
     n: usize,
@@ -566,9 +591,7 @@ struct Core<'a> {
 impl<'a> Core<'a> {
     fn new(xs: &'a DMatrix<f64>, use_gram: bool) -> Self {
         let (n, p) = xs.shape();
-        // `transpose() * x` goes through nalgebra's blocked gemm (matrixmultiply); `tr_mul`
-        // computes one dot product per entry and is ~15x slower on 5000 x 500
-        let gram = use_gram.then(|| xs.transpose() * xs);
+        let gram = use_gram.then(|| gram_matrix(xs));
         let sq_norms = match &gram {
             Some(g) => (0..p).map(|j| g[(j, j)]).collect(),
             None => (0..p).map(|j| xs.column(j).norm_squared()).collect(),

@@ -385,3 +385,29 @@ fn duplicate_of_the_first_column_is_excluded_at_the_first_step() {
 fn max_sk_gap(c: &Value) -> f64 {
     vector(&c["kkt_violation"]).into_iter().fold(0.0, f64::max)
 }
+
+#[test]
+fn blocked_gram_matrix_gives_the_same_path_as_passes_over_x() {
+    // p >= 256 switches the Gram matrix to its block-triangular product; the path must be the
+    // one computed from X directly (1e-9 relative, as elsewhere), and keep the conditions.
+    let mut rng = ChaCha8Rng::seed_from_u64(256);
+    let (n, p) = (320, 300);
+    let x: DMatrix<f64> = DMatrix::from_fn(n, p, |_, _| StandardNormal.sample(&mut rng));
+    let y: Vec<f64> = (0..n)
+        .map(|i| x[(i, 3)] - 2.0 * x[(i, 150)] + 0.5 * x[(i, 299)] + 0.1 * x[(i, 7)])
+        .collect();
+    let a = plain(Method::Lasso)
+        .gram(Gram::Precompute)
+        .max_steps(40)
+        .fit(&x, &y)
+        .expect("gram");
+    let b = plain(Method::Lasso)
+        .gram(Gram::Never)
+        .max_steps(40)
+        .fit(&x, &y)
+        .expect("x");
+    assert_eq!(a.n_knots(), b.n_knots());
+    let d = (a.coef_path() - b.coef_path()).amax();
+    assert!(d < 1e-9 * b.coef_path().amax(), "{d:e}");
+    assert!(kkt_violation(&x, &y, a.coef_path(), a.alphas(), true) < 1e-9);
+}
