@@ -1,6 +1,6 @@
 //! # trajpred
 //!
-//! Every method of trajpred behind one [`Predictor`](trajpred_core::Predictor), an
+//! Every method of trajpred behind one [`Predictor`], an
 //! evaluation harness that runs them over many trajectories, and the `trajpred` command-line
 //! tool.
 //!
@@ -27,7 +27,9 @@
 //! ```
 #![forbid(unsafe_code)]
 
+pub mod dataset;
 pub mod harness;
+pub mod plot;
 pub mod predictors;
 pub mod registry;
 

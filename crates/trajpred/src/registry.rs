@@ -14,6 +14,10 @@ pub struct MethodOptions {
     pub poly_points: usize,
     /// Seed of every randomised method.
     pub seed: u64,
+    /// Window length m of the GSC/GSKF.
+    pub window: usize,
+    /// Horizons T the multi-step models are fitted for (the longest forecast they answer).
+    pub horizons: usize,
 }
 
 impl Default for MethodOptions {
@@ -22,6 +26,8 @@ impl Default for MethodOptions {
             kf_q: 10.0,
             poly_points: 5,
             seed: 0,
+            window: 6,
+            horizons: 6,
         }
     }
 }
@@ -58,6 +64,14 @@ pub const METHODS: &[MethodInfo] = &[
         description: "least-squares parabola through the last N points, extrapolated",
     },
     MethodInfo {
+        name: "gsc",
+        description: "GSKF paper: group sparse coding (LAR per horizon), per axis",
+    },
+    MethodInfo {
+        name: "gskf",
+        description: "GSKF paper: GSC corrected by the improved one-step-ahead Kalman filter",
+    },
+    MethodInfo {
         name: "hmm",
         description: "k-means motion states + HMM forward filter (K chosen on training data)",
     },
@@ -75,6 +89,16 @@ pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
         "poly1" | "poly2" => Box::new(PolyFit::new(PolyFitParams {
             degree: if name == "poly1" { 1 } else { 2 },
             points: opts.poly_points,
+        })?),
+        "gsc" => Box::new(Gsc::new(GskfParams {
+            window: opts.window,
+            horizons: opts.horizons,
+            ..Default::default()
+        })?),
+        "gskf" => Box::new(Gskf::new(GskfParams {
+            window: opts.window,
+            horizons: opts.horizons,
+            ..Default::default()
         })?),
         "hmm" => Box::new(Hmm::new(HmmParams {
             seed: opts.seed,

@@ -1,9 +1,11 @@
 //! Every method of the four papers as a [`Predictor`](trajpred_core::Predictor).
 
+mod gskf;
 mod hmm;
 mod kf_dynamic;
 mod poly;
 
+pub use gskf::{Gsc, Gskf, GskfParams};
 pub use hmm::{Hmm, HmmParams};
 pub use kf_dynamic::{Continuation, KfDynamic, KfDynamicParams, NaiveKf};
 pub use poly::{PolyFit, PolyFitParams};

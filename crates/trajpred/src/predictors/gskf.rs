@@ -1,0 +1,446 @@
+//! Group sparse coding ([`Gsc`]) and MSTPM-GSKF ([`Gskf`]): the multi-step predictor of the
+//! GSKF paper (SPEC A.3-A.4), per axis.
+//!
+//! GSC: for each axis, the T horizon models `x_hat_{i+t} = A[t] . w_i + b[t]` fitted by LAR on
+//! the Hankel designs of the training series (`trajpred-sparse`).
+//!
+//! GSKF: the GSC prediction `X_hat^0(i)` is the prior `X(k|k-1)` of an improved one-step-ahead
+//! Kalman filter (`trajpred_kalman::Ikf`) whose state is the vector of the T predicted values,
+//! `H = I_T`, corrected with the previous residual (eq. 12-13):
+//! `X(k|k) = X(k|k-1) + P(k|k-1) S(k-1)^-1 V(k-1)`. The residual of horizon row `t` at origin
+//! `i` is the most recent one observable at time `i`: `V_t = x_i - X_hat^0_t(i - t)`. Nothing
+//! after the origin is used.
+
+use super::invalid;
+use nalgebra::{DMatrix, DVector, Dyn};
+use serde::{Deserialize, Serialize};
+use trajpred_core::{
+    Error, Forecast, Gaussian, Predictor, Result, Trajectory, check_forecast_args,
+};
+use trajpred_kalman::{Ikf, Innovation, LinearObservation, LinearTransition};
+use trajpred_sparse::GroupSparseCoder;
+
+/// Parameters of [`Gsc`] and [`Gskf`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GskfParams {
+    /// Window length m (the paper: 2..8, 6 for the multi-step tables).
+    pub window: usize,
+    /// Number of horizons T predicted at once (the paper: 1..6). Forecasts may ask for up to T
+    /// steps.
+    pub horizons: usize,
+    /// Process noise `Q = q I`; `None` chooses q on the training series (see
+    /// `docs/gskf.md`). Ignored by [`Gsc`].
+    pub q: Option<f64>,
+    /// The multipliers of the mean GSC residual variance tried when `q` is `None`.
+    pub q_grid: Vec<f64>,
+}
+
+impl Default for GskfParams {
+    fn default() -> Self {
+        GskfParams {
+            window: 6,
+            horizons: 6,
+            q: None,
+            q_grid: vec![1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0],
+        }
+    }
+}
+
+impl GskfParams {
+    fn validate(&self) -> Result<()> {
+        if self.window == 0 {
+            return Err(invalid("window", "m must be at least 1"));
+        }
+        if self.horizons == 0 {
+            return Err(invalid("horizons", "T must be at least 1"));
+        }
+        if let Some(q) = self.q
+            && !(q.is_finite() && q >= 0.0)
+        {
+            return Err(invalid(
+                "q",
+                format!("must be finite and non-negative, got {q}"),
+            ));
+        }
+        if self.q.is_none()
+            && (self.q_grid.is_empty() || self.q_grid.iter().any(|g| !(g.is_finite() && *g >= 0.0)))
+        {
+            return Err(invalid(
+                "q_grid",
+                "needs at least one finite, non-negative multiplier",
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn sparse_error(e: trajpred_sparse::Error) -> Error {
+    Error::method("gsc", e)
+}
+
+fn kalman_error(e: trajpred_kalman::KalmanError) -> Error {
+    Error::method("gskf", e)
+}
+
+/// The training series of axis `a`: one per trajectory long enough for the GSC designs.
+fn axis_series(train: &[Trajectory], axis: usize, needed: usize) -> Vec<&[f64]> {
+    train
+        .iter()
+        .filter(|t| t.len() >= needed)
+        .map(|t| t.axis(axis))
+        .collect()
+}
+
+fn fit_gsc(params: &GskfParams, series: &[&[f64]]) -> Result<GroupSparseCoder> {
+    GroupSparseCoder::params(params.window, params.horizons)
+        .fit_many(series)
+        .map_err(sparse_error)
+}
+
+/// The GSC prediction made at origin `i` (window ending at index `i`) of `x`.
+fn gsc_at(gsc: &GroupSparseCoder, x: &[f64], i: usize) -> Result<Vec<f64>> {
+    let m = gsc.window();
+    gsc.predict(&x[i + 1 - m..=i]).map_err(sparse_error)
+}
+
+/// The residual vector `V` at origin `i`: `V_t = x_i - X_hat^0_t(i - t)`, `t = 1..=T`.
+fn residuals(gsc: &GroupSparseCoder, x: &[f64], i: usize) -> Result<DVector<f64>> {
+    let t_max = gsc.horizons();
+    let mut v = DVector::zeros(t_max);
+    for t in 1..=t_max {
+        v[t - 1] = x[i] - gsc_at(gsc, x, i - t)?[t - 1];
+    }
+    Ok(v)
+}
+
+/// One axis of a fitted GSKF: the GSC, the IKF and its converged covariances.
+#[derive(Debug, Clone)]
+struct AxisFilter {
+    gsc: GroupSparseCoder,
+    ikf: Ikf<LinearTransition<f64, Dyn>, LinearObservation<f64, Dyn, Dyn>>,
+    /// `P(k|k-1)` at convergence.
+    p_prior: DMatrix<f64>,
+    /// `S(k-1) = P(k-1|k-2) + R` at convergence.
+    s: DMatrix<f64>,
+    /// The process noise level, `Q = q I`.
+    q: f64,
+}
+
+impl AxisFilter {
+    /// Builds the IKF for `q` and runs its covariance recursion, which does not depend on the
+    /// data (F, Q, R are fixed), to convergence.
+    fn new(gsc: GroupSparseCoder, q: f64) -> Result<Self> {
+        let (m, t) = (gsc.window(), gsc.horizons());
+        // F: the T predicted rows and columns of the m x m matrix of eq. 17-19 (for T <= m,
+        // the last T columns of A); identity when T > m (SPEC A.4)
+        let f = if t <= m {
+            gsc.coefficients().columns(m - t, t).into_owned()
+        } else {
+            DMatrix::identity(t, t)
+        };
+        let r_diag: Vec<f64> = gsc
+            .residual_variances()
+            .iter()
+            .map(|v| v.max(1e-300))
+            .collect();
+        let r = DMatrix::from_diagonal(&DVector::from_vec(r_diag));
+        let transition =
+            LinearTransition::new(f, DMatrix::identity(t, t) * q).map_err(kalman_error)?;
+        let observation =
+            LinearObservation::new(DMatrix::identity(t, t), r.clone()).map_err(kalman_error)?;
+        let ikf = Ikf::new(transition, observation).map_err(kalman_error)?;
+        // start from P(0|0) = R, with S(0) = F R F^T + Q + R
+        let mut post = r.clone();
+        let mut s = ikf
+            .propagate_covariance::<f64, Dyn, Dyn>(&post)
+            .map_err(kalman_error)?
+            + &r;
+        let mut p_prior = DMatrix::zeros(t, t);
+        for _ in 0..5000 {
+            p_prior = ikf
+                .propagate_covariance::<f64, Dyn, Dyn>(&post)
+                .map_err(kalman_error)?;
+            let prior = Gaussian {
+                mean: DVector::zeros(t),
+                covariance: p_prior.clone(),
+            };
+            let innov = Innovation::new(DVector::zeros(t), s.clone()).map_err(kalman_error)?;
+            let next = ikf
+                .correct(&prior, &innov)
+                .map_err(kalman_error)?
+                .covariance;
+            let change = (&next - &post).norm() / next.norm().max(1e-300);
+            post = next;
+            s = &p_prior + &r;
+            if change < 1e-13 {
+                break;
+            }
+        }
+        if p_prior.iter().any(|v| !v.is_finite()) {
+            return Err(Error::NotPositiveDefinite {
+                what: "GSKF covariance recursion (diverged)",
+            });
+        }
+        Ok(AxisFilter {
+            gsc,
+            ikf,
+            p_prior,
+            s,
+            q,
+        })
+    }
+
+    /// The corrected T-step prediction at origin `i` of `x` and its covariance.
+    fn predict(&self, x: &[f64], i: usize) -> Result<Gaussian<f64, Dyn>> {
+        let prior = Gaussian {
+            mean: DVector::from_vec(gsc_at(&self.gsc, x, i)?),
+            covariance: self.p_prior.clone(),
+        };
+        let v = residuals(&self.gsc, x, i)?;
+        let innov = Innovation::new(v, self.s.clone()).map_err(kalman_error)?;
+        self.ikf.correct(&prior, &innov).map_err(kalman_error)
+    }
+}
+
+/// Mean squared error of every horizon of the GSKF over the rolling origins of `series`.
+fn in_sample_error(filter: &AxisFilter, series: &[&[f64]]) -> Result<f64> {
+    let (m, t) = (filter.gsc.window(), filter.gsc.horizons());
+    let (mut sum, mut n) = (0.0, 0usize);
+    for x in series {
+        for i in (m + t - 1)..x.len().saturating_sub(t) {
+            let g = filter.predict(x, i)?;
+            for k in 0..t {
+                let e = g.mean[k] - x[i + 1 + k];
+                sum += e * e;
+                n += 1;
+            }
+        }
+    }
+    Ok(if n > 0 { sum / n as f64 } else { f64::INFINITY })
+}
+
+/// Group sparse coding alone (SPEC A.3): per axis, `X_hat = A w + b`.
+///
+/// ```
+/// use trajpred::predictors::{Gsc, GskfParams};
+/// use trajpred_core::{Predictor, Trajectory};
+/// let x: Vec<f64> = (0..300).map(|i| (0.1 * i as f64).sin()).collect();
+/// let tr = Trajectory::uniform(0.0, 1.0, vec![x.clone()])?;
+/// let mut p = Gsc::new(GskfParams { window: 4, horizons: 3, ..Default::default() })?;
+/// p.fit(&[tr.prefix(250)?])?;
+/// let f = p.forecast(&tr.prefix(260)?, 3)?;
+/// assert!((f.step(3)[0] - x[262]).abs() < 1e-8); // a sinusoid is an exact linear recurrence
+/// # Ok::<(), trajpred_core::Error>(())
+/// ```
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Gsc {
+    params: GskfParams,
+    #[serde(skip)]
+    axes: Vec<GroupSparseCoder>,
+}
+
+impl Gsc {
+    /// A validated, unfitted predictor.
+    pub fn new(params: GskfParams) -> Result<Self> {
+        params.validate()?;
+        Ok(Gsc {
+            params,
+            axes: Vec::new(),
+        })
+    }
+
+    /// The fitted coder of each axis.
+    pub fn coders(&self) -> &[GroupSparseCoder] {
+        &self.axes
+    }
+}
+
+fn check_history(
+    history: &Trajectory,
+    horizon: usize,
+    needed: usize,
+    horizons: usize,
+    dim: usize,
+    method: &str,
+) -> Result<()> {
+    check_forecast_args(history, horizon, needed)?;
+    if dim == 0 {
+        return Err(Error::NotFitted {
+            method: method.into(),
+        });
+    }
+    if horizon > horizons {
+        return Err(invalid(
+            "horizon",
+            format!("{method} was fitted for T = {horizons} horizons, asked for {horizon}"),
+        ));
+    }
+    if history.dim() != dim {
+        return Err(Error::DimensionMismatch {
+            what: "history vs fitted axes",
+            expected: dim,
+            got: history.dim(),
+        });
+    }
+    Ok(())
+}
+
+fn fit_axes(params: &GskfParams, train: &[Trajectory]) -> Result<Vec<GroupSparseCoder>> {
+    let dim = train
+        .first()
+        .ok_or(Error::Empty {
+            what: "training trajectories",
+        })?
+        .dim();
+    if let Some(bad) = train.iter().find(|t| t.dim() != dim) {
+        return Err(Error::DimensionMismatch {
+            what: "training trajectories",
+            expected: dim,
+            got: bad.dim(),
+        });
+    }
+    let needed = params.window + params.horizons + 1;
+    (0..dim)
+        .map(|a| fit_gsc(params, &axis_series(train, a, needed)))
+        .collect()
+}
+
+impl Predictor for Gsc {
+    fn name(&self) -> &str {
+        "gsc"
+    }
+
+    fn fit(&mut self, train: &[Trajectory]) -> Result<()> {
+        self.axes = fit_axes(&self.params, train)?;
+        Ok(())
+    }
+
+    fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
+        check_history(
+            history,
+            horizon,
+            self.min_history(),
+            self.params.horizons,
+            self.axes.len(),
+            "gsc",
+        )?;
+        let i = history.len() - 1;
+        let per_axis: Vec<Vec<f64>> = self
+            .axes
+            .iter()
+            .enumerate()
+            .map(|(a, g)| gsc_at(g, history.axis(a), i))
+            .collect::<Result<_>>()?;
+        let steps: Vec<Vec<f64>> = (0..horizon)
+            .map(|k| per_axis.iter().map(|p| p[k]).collect())
+            .collect();
+        Forecast::new(history.dim(), steps)
+    }
+
+    fn min_history(&self) -> usize {
+        self.params.window
+    }
+}
+
+/// MSTPM-GSKF (SPEC A.4): GSC corrected by the improved one-step-ahead Kalman filter.
+///
+/// `fit` fits the GSC per axis, sets `R` to the diagonal of the GSC training residual
+/// variances, and `Q = q I` with `q` chosen on the training series when not given. The
+/// forecast carries the per-step covariance (diagonal across axes).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Gskf {
+    params: GskfParams,
+    #[serde(skip)]
+    axes: Vec<AxisFilter>,
+}
+
+impl Gskf {
+    /// A validated, unfitted predictor.
+    pub fn new(params: GskfParams) -> Result<Self> {
+        params.validate()?;
+        Ok(Gskf {
+            params,
+            axes: Vec::new(),
+        })
+    }
+
+    /// The q chosen (or given) for each axis, once fitted.
+    pub fn process_noise(&self) -> Vec<f64> {
+        self.axes.iter().map(|a| a.q).collect()
+    }
+}
+
+impl Predictor for Gskf {
+    fn name(&self) -> &str {
+        "gskf"
+    }
+
+    fn fit(&mut self, train: &[Trajectory]) -> Result<()> {
+        let coders = fit_axes(&self.params, train)?;
+        let needed = self.params.window + self.params.horizons + 1;
+        self.axes = coders
+            .into_iter()
+            .enumerate()
+            .map(|(a, gsc)| {
+                let scale = gsc.residual_variances().iter().sum::<f64>()
+                    / gsc.residual_variances().len() as f64;
+                match self.params.q {
+                    Some(q) => AxisFilter::new(gsc, q),
+                    None => {
+                        let series = axis_series(train, a, needed);
+                        let mut best: Option<(f64, AxisFilter)> = None;
+                        for &g in &self.params.q_grid {
+                            let Ok(f) = AxisFilter::new(gsc.clone(), (g * scale).max(1e-300))
+                            else {
+                                continue;
+                            };
+                            let e = in_sample_error(&f, &series)?;
+                            if best.as_ref().is_none_or(|(b, _)| e < *b) {
+                                best = Some((e, f));
+                            }
+                        }
+                        best.map(|(_, f)| f).ok_or(Error::NotPositiveDefinite {
+                            what: "GSKF covariance recursion for every q of the grid",
+                        })
+                    }
+                }
+            })
+            .collect::<Result<_>>()?;
+        Ok(())
+    }
+
+    fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
+        check_history(
+            history,
+            horizon,
+            self.min_history(),
+            self.params.horizons,
+            self.axes.len(),
+            "gskf",
+        )?;
+        let i = history.len() - 1;
+        let per_axis: Vec<Gaussian<f64, Dyn>> = self
+            .axes
+            .iter()
+            .enumerate()
+            .map(|(a, f)| f.predict(history.axis(a), i))
+            .collect::<Result<_>>()?;
+        let steps: Vec<Vec<f64>> = (0..horizon)
+            .map(|k| per_axis.iter().map(|g| g.mean[k]).collect())
+            .collect();
+        let covs = (0..horizon)
+            .map(|k| {
+                DMatrix::from_diagonal(&DVector::from_iterator(
+                    per_axis.len(),
+                    per_axis.iter().map(|g| g.covariance[(k, k)]),
+                ))
+            })
+            .collect();
+        Forecast::new(history.dim(), steps)?.with_covariances(covs)
+    }
+
+    fn min_history(&self) -> usize {
+        // the residual of horizon T needs the prediction made T steps ago
+        self.params.window + self.params.horizons
+    }
+}

@@ -1,0 +1,233 @@
+//! Each predictor against values worked independently of its code.
+
+use trajpred::predictors::*;
+use trajpred_core::{Error, Predictor, Trajectory};
+
+#[test]
+fn polyfit_is_exact_on_polynomials_with_uneven_sampling() {
+    // x = 2 + 3t, y = 1 - t + 0.5 t^2 sampled at uneven times; the step is the mean interval
+    let t = [0.0, 0.7, 2.0, 2.9, 4.0];
+    let x: Vec<f64> = t.iter().map(|t| 2.0 + 3.0 * t).collect();
+    let y: Vec<f64> = t.iter().map(|t| 1.0 - t + 0.5 * t * t).collect();
+    let tr = Trajectory::from_axes(t.to_vec(), vec![x, y]).unwrap();
+    let dt = 4.0 / 4.0;
+    let quad = PolyFit::new(PolyFitParams {
+        degree: 2,
+        points: 5,
+    })
+    .unwrap();
+    let f = quad.forecast(&tr, 3).unwrap();
+    for k in 1..=3 {
+        let tk = 4.0 + dt * k as f64;
+        assert!((f.step(k)[0] - (2.0 + 3.0 * tk)).abs() < 1e-9);
+        assert!((f.step(k)[1] - (1.0 - tk + 0.5 * tk * tk)).abs() < 1e-9);
+    }
+    // the line through the last 2 points of x is exact too; its step is their interval, 1.1 s
+    let lin = PolyFit::new(PolyFitParams {
+        degree: 1,
+        points: 2,
+    })
+    .unwrap();
+    assert!((lin.forecast(&tr, 1).unwrap().step(1)[0] - (2.0 + 3.0 * 5.1)).abs() < 1e-9);
+    assert!(matches!(
+        PolyFit::new(PolyFitParams {
+            degree: 3,
+            points: 5
+        }),
+        Err(Error::InvalidParameter { name: "degree", .. })
+    ));
+    assert!(matches!(
+        PolyFit::new(PolyFitParams {
+            degree: 2,
+            points: 2
+        }),
+        Err(Error::InvalidParameter { name: "points", .. })
+    ));
+    assert!(matches!(
+        quad.forecast(&tr.prefix(4).unwrap(), 1),
+        Err(Error::TooShort {
+            needed: 5,
+            got: 4,
+            ..
+        })
+    ));
+}
+
+#[test]
+fn kf_dynamic_and_naive_kf_extrapolate_uniform_motion() {
+    // 1.5 m/s east, -0.5 m/s north, sampled every 2 s, no noise: both filters converge on the
+    // velocity, so step k lands at the last point + k * dt * v (to well under a metre)
+    let n = 60;
+    let tr = Trajectory::uniform(
+        0.0,
+        2.0,
+        vec![
+            (0..n).map(|i| 3.0 * i as f64).collect(),
+            (0..n).map(|i| -(i as f64)).collect(),
+        ],
+    )
+    .unwrap();
+    let extrapolating = KfDynamicParams {
+        multi_step: Continuation::Extrapolate,
+        ..KfDynamicParams::paper_position(10.0)
+    };
+    for p in [
+        Box::new(KfDynamic::new(extrapolating).unwrap()) as Box<dyn Predictor>,
+        Box::new(
+            KfDynamic::new(KfDynamicParams {
+                multi_step: Continuation::Extrapolate,
+                ..KfDynamicParams::paper_position_velocity(100.0)
+            })
+            .unwrap(),
+        ),
+        Box::new(NaiveKf::new(KfDynamicParams::paper_position(10.0)).unwrap()),
+    ] {
+        let f = p.forecast(&tr, 5).unwrap();
+        for k in 1..=5 {
+            let ex = 3.0 * (n - 1 + k) as f64;
+            let ey = -((n - 1 + k) as f64);
+            assert!(
+                (f.step(k)[0] - ex).abs() < 0.5,
+                "{} step {k}: {:?}",
+                p.name(),
+                f.step(k)
+            );
+            assert!((f.step(k)[1] - ey).abs() < 0.5, "{} step {k}", p.name());
+            let c = f.covariance(k).unwrap();
+            assert!(c[(0, 0)] > 0.0 && c[(1, 1)] > 0.0);
+        }
+        // the uncertainty grows with the horizon
+        assert!(f.covariance(5).unwrap()[(0, 0)] > f.covariance(1).unwrap()[(0, 0)]);
+    }
+    // The paper's literal multi-step rule re-applies eq. 13-15 with the LAST observation at
+    // every step, which pulls steps 2.. back towards it: step 1 is right, later steps fall
+    // short of the extrapolation (the pull is K (Z(k) - H X), towards the stale point).
+    let literal = KfDynamic::new(KfDynamicParams::paper_position(10.0)).unwrap();
+    let f = literal.forecast(&tr, 3).unwrap();
+    assert!((f.step(1)[0] - 3.0 * n as f64).abs() < 0.5);
+    let last = 3.0 * (n - 1) as f64;
+    for k in 2..=3 {
+        assert!(f.step(k)[0] > last && f.step(k)[0] < last + 3.0 * k as f64 - 0.5);
+    }
+    assert!(matches!(
+        KfDynamic::new(KfDynamicParams {
+            q: -1.0,
+            ..Default::default()
+        }),
+        Err(Error::InvalidParameter { name: "q", .. })
+    ));
+}
+
+/// Eq. 20 of the GSKF paper without noise is a sum of sinusoids, which a linear recurrence of
+/// order <= 4 reproduces exactly (SPEC A.5): with m = 6 both GSC and GSKF predict the test
+/// part to rounding error.
+#[test]
+fn gsc_and_gskf_are_exact_on_noiseless_eq20() {
+    let tr = trajpred_data::synthetic::gskf_eq20();
+    let train = tr.prefix(800).unwrap();
+    for p in [
+        Box::new(Gsc::new(GskfParams::default()).unwrap()) as Box<dyn Predictor>,
+        Box::new(Gskf::new(GskfParams::default()).unwrap()),
+    ] {
+        let mut p = p;
+        p.fit(std::slice::from_ref(&train)).unwrap();
+        let mut worst: f64 = 0.0;
+        for origin in (800..994).step_by(7) {
+            let f = p.forecast(&tr.prefix(origin + 1).unwrap(), 6).unwrap();
+            for k in 1..=6 {
+                let truth = tr.point(origin + k);
+                for a in 0..3 {
+                    worst = worst.max((f.step(k)[a] - truth[a]).abs());
+                }
+            }
+        }
+        assert!(worst < 1e-9, "{}: worst error {worst}", p.name());
+    }
+}
+
+/// The IKF correction with T = 1 against a scalar recursion written out here: the converged
+/// gain K = P(k|k-1) / S(k-1) of `P- = a^2 P+ + q`, `S = P-(previous) + r`,
+/// `P+ = (1 - K)^2 P- + K^2 r`, and the forecast `x_hat^0 + K (x_i - x_hat^0(i - 1))`.
+#[test]
+fn gskf_correction_matches_a_scalar_recursion_by_hand() {
+    // a noisy AR(2)-like series so the GSC residuals are not zero
+    let mut x = vec![0.0, 1.0];
+    let mut state = 12345u64;
+    for i in 2..400 {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let u = ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5;
+        x.push(1.6 * x[i - 1] - 0.8 * x[i - 2] + u);
+    }
+    let tr = Trajectory::uniform(0.0, 1.0, vec![x.clone()]).unwrap();
+    let q = 0.05;
+    let params = GskfParams {
+        window: 2,
+        horizons: 1,
+        q: Some(q),
+        ..Default::default()
+    };
+    let mut gsc = Gsc::new(params.clone()).unwrap();
+    let mut gskf = Gskf::new(params).unwrap();
+    let train = tr.prefix(300).unwrap();
+    gsc.fit(std::slice::from_ref(&train)).unwrap();
+    gskf.fit(std::slice::from_ref(&train)).unwrap();
+    let coder = &gsc.coders()[0];
+    let a = coder.coefficients()[(0, 1)]; // F = the T = 1 predicted column of A
+    let r = coder.residual_variances()[0];
+    let (mut post, mut s_prev, mut k) = (r, a * a * r + q + r, 0.0);
+    for _ in 0..10_000 {
+        let prior = a * a * post + q;
+        k = prior / s_prev;
+        post = (1.0 - k) * (1.0 - k) * prior + k * k * r;
+        s_prev = prior + r;
+    }
+    for origin in [320, 350, 398] {
+        let h = tr.prefix(origin + 1).unwrap();
+        let g_now = gsc.forecast(&h, 1).unwrap().step(1)[0];
+        let g_prev = gsc
+            .forecast(&tr.prefix(origin).unwrap(), 1)
+            .unwrap()
+            .step(1)[0];
+        let expected = g_now + k * (x[origin] - g_prev);
+        let got = gskf.forecast(&h, 1).unwrap().step(1)[0];
+        assert!(
+            (got - expected).abs() < 1e-9 * (1.0 + expected.abs()),
+            "{got} vs {expected}"
+        );
+    }
+    assert!(matches!(
+        gskf.forecast(&tr, 2),
+        Err(Error::InvalidParameter {
+            name: "horizon",
+            ..
+        })
+    ));
+    let unfitted = Gskf::new(GskfParams::default()).unwrap();
+    assert!(matches!(
+        unfitted.forecast(&tr, 1),
+        Err(Error::NotFitted { .. })
+    ));
+}
+
+#[test]
+fn hmm_errors() {
+    let one_point = Trajectory::uniform(0.0, 1.0, vec![vec![1.0]]).unwrap();
+    let mut h = Hmm::new(HmmParams::default()).unwrap();
+    assert!(matches!(
+        h.fit(std::slice::from_ref(&one_point)),
+        Err(Error::Empty { .. })
+    ));
+    assert!(matches!(
+        h.forecast(&one_point, 1),
+        Err(Error::NotFitted { .. })
+    ));
+    assert!(matches!(
+        Hmm::new(HmmParams {
+            states: Some(0),
+            ..Default::default()
+        }),
+        Err(Error::InvalidParameter { name: "states", .. })
+    ));
+}
