@@ -3,7 +3,9 @@
 //! update forms [`CovarianceUpdate`], and the RTS smoother [`Smoother`].
 
 use crate::error::{KalmanError, Result};
-use crate::linalg::{Chol, check_dim, check_finite, check_state, cholesky, symmetrise};
+use crate::linalg::{
+    Chol, check_dim, check_finite, check_state, cholesky, mul, mul_tr, mul_vec, symmetrise,
+};
 use crate::model::Observation;
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
@@ -129,6 +131,16 @@ where
         self.update(prior, z)
     }
 
+    /// The prediction from a state that this filter produced itself (the posterior or the
+    /// prediction of an earlier step): the same result as [`Filter::predict`], but a filter
+    /// may skip the factorisation that checks `P` positive semi-definite, since its own
+    /// outputs are by construction (shapes, finite values and symmetry are still checked).
+    /// [`Filter::filter`] and [`Filter::forecast`] use it after their first step, so a batch
+    /// validates the user's initial state fully once.
+    fn predict_own_output(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
+        self.predict(state)
+    }
+
     /// The prediction with a known control effect `B u` (already mapped to the state space)
     /// added to the predicted mean: `x(k|k-1) = f(x) + B u`. The covariance is unchanged,
     /// since the control input carries no noise.
@@ -165,7 +177,14 @@ where
         let mut out: Vec<Step<T, D, M>> = Vec::with_capacity(observations.len());
         for z in observations {
             let step = match out.last() {
-                Some(prev) => self.step(prev.posterior(), z.as_ref())?,
+                Some(prev) => {
+                    let prior = self.predict_own_output(prev.posterior())?;
+                    let update = match z {
+                        Some(z) => Some(self.update_predicted(&prior, z)?),
+                        None => None,
+                    };
+                    Step { prior, update }
+                }
                 None => self.step(initial, z.as_ref())?,
             };
             out.push(step);
@@ -192,7 +211,7 @@ where
         let mut out: Vec<Gaussian<T, D>> = Vec::with_capacity(steps);
         for _ in 0..steps {
             let next = match out.last() {
-                Some(prev) => self.predict(prev)?,
+                Some(prev) => self.predict_own_output(prev)?,
                 None => self.predict(state)?,
             };
             out.push(next);
@@ -286,7 +305,9 @@ where
     let n = state.mean.nrows();
     check_dim("F rows", n, f.nrows())?;
     check_dim("F columns", n, f.ncols())?;
-    let mut p = f * &state.covariance * f.transpose() + q;
+    let fp = mul(f, &state.covariance);
+    let mut p = mul_tr(&fp, f);
+    p += q;
     symmetrise(&mut p);
     check_finite(&mean, "predicted mean")?;
     check_finite(&p, "predicted covariance")?;
@@ -328,8 +349,9 @@ where
     check_dim("h(x)", m, predicted_z.nrows())?;
     let r = observation.observation_noise();
     let p = &prior.covariance;
-    let hp = h * p;
-    let mut s = &hp * h.transpose() + r;
+    let hp = mul(h, p);
+    let mut s = mul_tr(&hp, h);
+    s += r;
     symmetrise(&mut s);
     let chol = cholesky(s.clone(), "S")?;
     // K^T = S^-1 H P (P symmetric)
@@ -337,20 +359,25 @@ where
     chol.solve_mut(&mut kt);
     let gain = kt.transpose();
     let y = observation.observation_residual(z, predicted_z);
-    let mean = &prior.mean + &gain * &y;
+    let mut mean = mul_vec(&gain, &y);
+    mean += &prior.mean;
+    // Joseph form expanded: (I - K H) P (I - K H)^T + K R K^T
+    //   = P - K H P - (K H P)^T + K (H P H^T + R) K^T = P - A - A^T + K S K^T,
+    // algebraically equal for any gain K, in a third of the products
+    let a = mul(&gain, &hp);
     let mut cov = match form {
         CovarianceUpdate::Joseph => {
-            let mut ikh = -(&gain * h);
-            for i in 0..n {
-                ikh[(i, i)] += T::one();
+            let mut c = mul_tr(&mul(&gain, &s), &gain);
+            for j in 0..n {
+                for i in 0..n {
+                    c[(i, j)] += p[(i, j)] - a[(i, j)] - a[(j, i)];
+                }
             }
-            let mut c = &ikh * p * ikh.transpose() + &gain * r * gain.transpose();
-            symmetrise(&mut c);
             c
         }
-        CovarianceUpdate::Plain | CovarianceUpdate::Symmetrised => p - &gain * &hp,
+        CovarianceUpdate::Plain | CovarianceUpdate::Symmetrised => p - a,
     };
-    if form == CovarianceUpdate::Symmetrised {
+    if form != CovarianceUpdate::Plain {
         symmetrise(&mut cov);
     }
     let log_likelihood = gaussian_log_likelihood(&chol, &y);

@@ -7,7 +7,7 @@ use crate::filter::{
     CovarianceUpdate, Filter, InputChecks, PredictionWithCross, Smoother, Update,
     linearized_predict, linearized_update, validate_state,
 };
-use crate::linalg::check_dim;
+use crate::linalg::{check_dim, mul_vec};
 use crate::model::{
     LinearObservationModel, LinearTransitionModel, ObservationJacobian, TransitionJacobian,
     validate_models,
@@ -116,7 +116,14 @@ where
     fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
         validate_state(state, self.transition.state_dim(), self.checks)?;
         let f = self.transition.transition_matrix();
-        let mean = f * &state.mean;
+        let mean = mul_vec(f, &state.mean);
+        linearized_predict(mean, f, state, self.transition.process_noise())
+    }
+
+    fn predict_own_output(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
+        validate_state(state, self.transition.state_dim(), InputChecks::Cheap)?;
+        let f = self.transition.transition_matrix();
+        let mean = mul_vec(f, &state.mean);
         linearized_predict(mean, f, state, self.transition.process_noise())
     }
 
@@ -133,7 +140,7 @@ where
     ) -> Result<Update<T, D, M>> {
         check_dim("prior", self.transition.state_dim(), prior.mean.nrows())?;
         let h = self.observation.observation_matrix();
-        let zp = h * &prior.mean;
+        let zp = mul_vec(h, &prior.mean);
         linearized_update(&self.observation, prior, &zp, h, z, self.covariance_update)
     }
 }
@@ -235,12 +242,13 @@ where
         + Allocator<M, D>,
 {
     fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
-        let n = self.transition.state_dim();
-        validate_state(state, n, self.checks)?;
-        let mean = self.transition.transition(&state.mean)?;
-        check_dim("f(x)", n, mean.nrows())?;
-        let f = self.transition.transition_jacobian(&state.mean)?;
-        linearized_predict(mean, &f, state, self.transition.process_noise())
+        validate_state(state, self.transition.state_dim(), self.checks)?;
+        self.predict_validated(state)
+    }
+
+    fn predict_own_output(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
+        validate_state(state, self.transition.state_dim(), InputChecks::Cheap)?;
+        self.predict_validated(state)
     }
 
     fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>> {
@@ -258,6 +266,23 @@ where
         let zp = self.observation.observe(&prior.mean)?;
         let h = self.observation.observation_jacobian(&prior.mean)?;
         linearized_update(&self.observation, prior, &zp, &h, z, self.covariance_update)
+    }
+}
+
+impl<Tr, Ob> Ekf<Tr, Ob> {
+    /// The prediction of an already validated state.
+    fn predict_validated<T, D>(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>>
+    where
+        T: RealField + Copy,
+        D: Dim,
+        Tr: TransitionJacobian<T, D>,
+        DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    {
+        let n = self.transition.state_dim();
+        let mean = self.transition.transition(&state.mean)?;
+        check_dim("f(x)", n, mean.nrows())?;
+        let f = self.transition.transition_jacobian(&state.mean)?;
+        linearized_predict(mean, &f, state, self.transition.process_noise())
     }
 }
 

@@ -3,7 +3,7 @@
 
 use crate::error::{KalmanError, Result};
 use nalgebra::allocator::Allocator;
-use nalgebra::{DefaultAllocator, Dim, Matrix, OMatrix, RealField, Storage};
+use nalgebra::{Const, DefaultAllocator, Dim, Matrix, OMatrix, OVector, RealField, Storage};
 use trajpred_core::Gaussian;
 
 /// Errors with [`KalmanError::NonFinite`] if any element of `m` is NaN or infinite.
@@ -15,9 +15,109 @@ where
     C: Dim,
     S: Storage<T, R, C>,
 {
+    if all_finite(m) {
+        return Ok(());
+    }
     match m.iter().position(|v| !v.is_finite()) {
         Some(index) => Err(KalmanError::NonFinite { what, index }),
         None => Ok(()),
+    }
+}
+
+/// `true` when no element of `m` is NaN or infinite: one pass without early exit, so the
+/// compiler vectorises it (the index of a bad value is looked up only on failure).
+#[inline(always)]
+#[allow(clippy::eq_op)] // `v - v` is the finiteness test, not a mistake
+pub(crate) fn all_finite<T, R, C, S>(m: &Matrix<T, R, C, S>) -> bool
+where
+    T: RealField + Copy,
+    R: Dim,
+    C: Dim,
+    S: Storage<T, R, C>,
+{
+    // v - v is 0 for a finite v and NaN for an infinite or NaN one: a float comparison that
+    // vectorises (is_finite compiles to integer bit tests, one element at a time)
+    m.iter().fold(true, |acc, &v| acc & (v - v == T::zero()))
+}
+
+/// `true` when the sizes `R`, `C` are both known at compile time (stack storage): the
+/// small-matrix kernels below then run as unrolled loops without heap allocation.
+#[inline(always)]
+pub(crate) fn is_static<R: Dim, C: Dim>() -> bool {
+    R::try_to_usize().is_some() && C::try_to_usize().is_some()
+}
+
+/// The product `a b`: explicit loops (column by column, `out[:, j] += a[:, l] b[l, j]`) for
+/// static sizes, nalgebra's product otherwise.
+#[inline(always)]
+pub(crate) fn mul<T, R, K, C>(a: &OMatrix<T, R, K>, b: &OMatrix<T, K, C>) -> OMatrix<T, R, C>
+where
+    T: RealField + Copy,
+    R: Dim,
+    K: Dim,
+    C: Dim,
+    DefaultAllocator: Allocator<R, K> + Allocator<K, C> + Allocator<R, C>,
+{
+    if is_static::<R, K>() && is_static::<K, C>() && K::try_to_usize() != Some(0) {
+        let (r, k) = a.shape_generic();
+        let c = b.shape_generic().1;
+        OMatrix::<T, R, C>::from_fn_generic(r, c, |i, j| {
+            let mut acc = a[(i, 0)] * b[(0, j)];
+            for l in 1..k.value() {
+                acc += a[(i, l)] * b[(l, j)];
+            }
+            acc
+        })
+    } else {
+        a * b
+    }
+}
+
+/// The product `a b^T` (same strategy as [`mul`]).
+#[inline(always)]
+pub(crate) fn mul_tr<T, R, K, C>(a: &OMatrix<T, R, K>, b: &OMatrix<T, C, K>) -> OMatrix<T, R, C>
+where
+    T: RealField + Copy,
+    R: Dim,
+    K: Dim,
+    C: Dim,
+    DefaultAllocator: Allocator<R, K> + Allocator<C, K> + Allocator<K, C> + Allocator<R, C>,
+{
+    if is_static::<R, K>() && is_static::<K, C>() && K::try_to_usize() != Some(0) {
+        let (r, k) = a.shape_generic();
+        let c = b.shape_generic().0;
+        OMatrix::<T, R, C>::from_fn_generic(r, c, |i, j| {
+            let mut acc = a[(i, 0)] * b[(j, 0)];
+            for l in 1..k.value() {
+                acc += a[(i, l)] * b[(j, l)];
+            }
+            acc
+        })
+    } else {
+        a * b.transpose()
+    }
+}
+
+/// The product `a v` of a matrix and a vector (same strategy as [`mul`]).
+#[inline(always)]
+pub(crate) fn mul_vec<T, R, K>(a: &OMatrix<T, R, K>, v: &OVector<T, K>) -> OVector<T, R>
+where
+    T: RealField + Copy,
+    R: Dim,
+    K: Dim,
+    DefaultAllocator: Allocator<R, K> + Allocator<K> + Allocator<R>,
+{
+    if is_static::<R, K>() && K::try_to_usize() != Some(0) {
+        let (r, k) = a.shape_generic();
+        OVector::<T, R>::from_fn_generic(r, Const::<1>, |i, _| {
+            let mut acc = a[(i, 0)] * v[0];
+            for l in 1..k.value() {
+                acc += a[(i, l)] * v[l];
+            }
+            acc
+        })
+    } else {
+        a * v
     }
 }
 
@@ -187,6 +287,81 @@ where
     D: Dim,
     DefaultAllocator: Allocator<D, D>,
 {
+    if is_psd(m) {
+        Ok(())
+    } else {
+        psd_error(m, what)
+    }
+}
+
+/// The verdict of [`check_psd`] without the error: finite, symmetric, non-negative diagonal
+/// and `m + 64 n eps max|m| I` positive definite, in one branch-free pass over the elements
+/// before the factorisation.
+#[inline(always)]
+pub(crate) fn is_psd<T, D>(m: &OMatrix<T, D, D>) -> bool
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D>,
+{
+    if !all_finite(m) {
+        return false;
+    }
+    let scale = amax_finite(m);
+    if !is_symmetric_with_nonnegative_diagonal(m, scale) {
+        return false;
+    }
+    if scale == T::zero() {
+        return true;
+    }
+    let n = m.nrows();
+    let jitter = T::default_epsilon() * nalgebra::convert::<f64, T>(64.0 * n as f64) * scale;
+    positive_definite_shifted(m.clone(), jitter)
+}
+
+/// `max |m_ij|` of a matrix without NaN.
+#[inline(always)]
+fn amax_finite<T, D>(m: &OMatrix<T, D, D>) -> T
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D>,
+{
+    m.iter().fold(T::zero(), |s, v| {
+        let a = v.abs();
+        if a > s { a } else { s }
+    })
+}
+
+/// Symmetric to [`symmetry_tolerance`] of `scale = max|m|`, with a non-negative diagonal
+/// (branch-free).
+#[inline(always)]
+fn is_symmetric_with_nonnegative_diagonal<T, D>(m: &OMatrix<T, D, D>, scale: T) -> bool
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D>,
+{
+    let tol = symmetry_tolerance(scale);
+    let mut ok = true;
+    for j in 0..m.nrows() {
+        ok &= m[(j, j)] >= T::zero();
+        for i in 0..j {
+            ok &= (m[(i, j)] - m[(j, i)]).abs() <= tol;
+        }
+    }
+    ok
+}
+
+/// The error [`check_psd`] reports (the slow path, taken only when [`is_psd`] failed).
+#[cold]
+#[inline(never)]
+fn psd_error<T, D>(m: &OMatrix<T, D, D>, what: &'static str) -> Result<()>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D>,
+{
     check_finite(m, what)?;
     let n = m.nrows();
     let scale = m.amax();
@@ -205,11 +380,47 @@ where
         return Ok(());
     }
     let jitter = T::default_epsilon() * nalgebra::convert::<f64, T>(64.0 * n as f64) * scale;
-    let mut shifted = m.clone();
-    for i in 0..n {
-        shifted[(i, i)] += jitter;
+    if positive_definite_shifted(m.clone(), jitter) {
+        Ok(())
+    } else {
+        Err(KalmanError::NotPositiveDefinite { what })
     }
-    cholesky(shifted, what).map(|_| ())
+}
+
+/// Whether the symmetric matrix `a + shift I` (lower triangle read) is positive definite:
+/// an `L D L^T` factorisation without square roots and with one division per pivot, all
+/// pivots `d_j` strictly positive and finite. Cheaper than [`Chol::new`] when only the
+/// verdict is needed.
+#[inline(always)]
+pub(crate) fn positive_definite_shifted<T, D>(mut a: OMatrix<T, D, D>, shift: T) -> bool
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D>,
+{
+    let n = a.nrows();
+    for j in 0..n {
+        // row j of L is in a[(j, k)], k < j; w_k = L_jk d_k goes to the unused a[(k, j)]
+        let mut d = a[(j, j)] + shift;
+        for k in 0..j {
+            let w = a[(j, k)] * a[(k, k)];
+            a[(k, j)] = w;
+            d -= a[(j, k)] * w;
+        }
+        if d <= T::zero() || !d.is_finite() {
+            return false;
+        }
+        a[(j, j)] = d;
+        let inv = T::one() / d;
+        for i in (j + 1)..n {
+            let mut s = a[(i, j)];
+            for k in 0..j {
+                s -= a[(i, k)] * a[(k, j)];
+            }
+            a[(i, j)] = s * inv;
+        }
+    }
+    true
 }
 
 /// Checks that `m` is symmetric positive definite (its Cholesky factor exists).
@@ -245,9 +456,31 @@ where
 {
     check_dim("state mean", n, state.mean.nrows())?;
     check_square(&state.covariance, n, "state covariance")?;
+    let p = &state.covariance;
+    if all_finite(&state.mean)
+        && (if full {
+            is_psd(p)
+        } else {
+            all_finite(p) && is_symmetric_with_nonnegative_diagonal(p, amax_finite(p))
+        })
+    {
+        return Ok(());
+    }
+    state_error(state, n, full)
+}
+
+/// The error [`check_state`] reports (the slow path, taken only when a fast check failed).
+#[cold]
+#[inline(never)]
+fn state_error<T, D>(state: &Gaussian<T, D>, n: usize, full: bool) -> Result<()>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
     check_finite(&state.mean, "state mean")?;
     if full {
-        return check_psd(&state.covariance, "P");
+        return psd_error(&state.covariance, "P");
     }
     let p = &state.covariance;
     check_finite(p, "P")?;

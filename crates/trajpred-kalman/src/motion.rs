@@ -439,6 +439,10 @@ impl<T: RealField + Copy> RangeBearing<T> {
 
 /// Wraps an angle into `[-pi, pi)`.
 pub fn wrap_angle<T: RealField + Copy>(a: T) -> T {
+    // the common case, an angle already in range, without the (slow) floating remainder
+    if a >= -T::pi() && a < T::pi() {
+        return a;
+    }
     let two_pi = T::two_pi();
     let r = (a + T::pi()) % two_pi;
     let r = if r < T::zero() { r + two_pi } else { r };

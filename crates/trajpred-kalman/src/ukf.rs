@@ -173,6 +173,7 @@ fn unscented_transform<T, D, E, G, R>(
     w: &SigmaWeights<T>,
     g: G,
     residual: R,
+    with_cross: bool,
 ) -> Result<Transformed<T, D, E>>
 where
     T: RealField + Copy,
@@ -217,7 +218,9 @@ where
         let rm = residual(&minus.column(j).into_owned(), &mean);
         covariance.ger(w.other, &rp, &rp, T::one());
         covariance.ger(w.other, &rm, &rm, T::one());
-        cross.ger(w.other, &l.column(j), &(rp - rm), T::one());
+        if with_cross {
+            cross.ger(w.other, &l.column(j), &(rp - rm), T::one());
+        }
     }
     Ok(Transformed {
         mean,
@@ -308,7 +311,7 @@ where
         + Allocator<M, D>,
 {
     fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
-        self.prediction_with_cross_covariance(state).map(|(g, _)| g)
+        self.predict_transform(state, false).map(|(g, _)| g)
     }
 
     fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>> {
@@ -331,6 +334,7 @@ where
             &self.weights,
             |x| ob.observe(x),
             |a, b| ob.observation_residual(a, b),
+            true,
         )?;
         check_dim("h(x)", m, t.mean.nrows())?;
         let z_hat = ob.normalize_observation(t.mean);
@@ -378,6 +382,23 @@ where
         &self,
         filtered: &Gaussian<T, D>,
     ) -> Result<PredictionWithCross<T, D>> {
+        self.predict_transform(filtered, true)
+    }
+}
+
+impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
+    /// The prediction, and when `with_cross` the cross-covariance `Cov(x(k), x(k+1))` (the
+    /// smoother's; zero otherwise, not computed).
+    fn predict_transform<D>(
+        &self,
+        filtered: &Gaussian<T, D>,
+        with_cross: bool,
+    ) -> Result<PredictionWithCross<T, D>>
+    where
+        D: Dim,
+        Tr: Transition<T, D>,
+        DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    {
         let n = self.transition.state_dim();
         validate_state(filtered, n, UKF_CHECKS)?;
         let tr = &self.transition;
@@ -386,6 +407,7 @@ where
             &self.weights,
             |x| tr.transition(x),
             |a, b| tr.state_residual(a, b),
+            with_cross,
         )?;
         check_dim("f(x)", n, t.mean.nrows())?;
         let mut p = t.covariance + tr.process_noise();
