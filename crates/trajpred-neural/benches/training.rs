@@ -12,6 +12,10 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use trajpred_core::Trajectory;
+use trajpred_neural::burn::module::Module;
+use trajpred_neural::burn::nn::{Linear, LinearConfig, Lstm, LstmConfig};
+use trajpred_neural::burn::optim::{AdamConfig, GradientsParams};
+use trajpred_neural::burn::tensor::{Device, Tensor, TensorData};
 use trajpred_neural::{
     AxisMode, KfuConfig, KfuLstmNet, LstmArch, LstmNet, RecurrentLayers, TrainConfig, WindowConfig,
 };
@@ -61,7 +65,58 @@ fn lstm_epoch(c: &mut Criterion, name: &str, fc: Vec<usize>) {
     });
 }
 
+/// burn's own `nn::Lstm` (one linear map per gate), 2 x 64 + Linear(64, 3), the same 50
+/// batches of 16 windows: the reference for our fused layer, in the same sitting.
+#[derive(Module, Debug)]
+struct BurnLstm {
+    l0: Lstm,
+    l1: Lstm,
+    out: Linear,
+}
+
+fn burn_lstm_epoch(c: &mut Criterion) {
+    let device = Device::flex().autodiff();
+    let tr = sine(800, 0.0, 0.0);
+    let (m, n) = (10, 790);
+    let mut xs = Vec::new();
+    let mut ys = Vec::new();
+    for i in 0..n {
+        for s in i..i + m {
+            xs.extend((0..3).map(|k| tr.axis(k)[s] as f32));
+        }
+        ys.extend((0..3).map(|k| tr.axis(k)[i + m] as f32));
+    }
+    let mut model = BurnLstm {
+        l0: LstmConfig::new(3, 64, true).init(&device),
+        l1: LstmConfig::new(64, 64, true).init(&device),
+        out: LinearConfig::new(64, 3).init(&device),
+    };
+    let mut opt = AdamConfig::new().with_epsilon(1e-8).init();
+    c.bench_function("burn_nn_lstm_epoch_800x10_b16", |b| {
+        b.iter(|| {
+            for start in (0..n).step_by(16) {
+                let bs = 16.min(n - start);
+                let x = Tensor::<3>::from_data(
+                    TensorData::new(xs[start * m * 3..(start + bs) * m * 3].to_vec(), [bs, m, 3]),
+                    &device,
+                );
+                let y = Tensor::<2>::from_data(
+                    TensorData::new(ys[start * 3..(start + bs) * 3].to_vec(), [bs, 3]),
+                    &device,
+                );
+                let (h, _) = model.l0.forward(x, None);
+                let (_, s) = model.l1.forward(h, None);
+                let d = model.out.forward(s.hidden) - y;
+                let loss = (d.clone() * d).mean();
+                let grads = GradientsParams::from_grads(loss.backward(), &model);
+                model = opt.step(1e-3, model.clone(), grads);
+            }
+        })
+    });
+}
+
 fn benches(c: &mut Criterion) {
+    burn_lstm_epoch(c);
     lstm_epoch(c, "lstm_epoch_800x10_b16", vec![64]);
     lstm_epoch(c, "lstm_epoch_800x10_b16_plain_head", vec![]);
     let data: Vec<Trajectory> = (0..16).map(|i| sine(200, i as f64 * 0.4, 0.1)).collect();
