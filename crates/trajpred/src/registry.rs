@@ -72,6 +72,14 @@ pub const METHODS: &[MethodInfo] = &[
         description: "GSKF paper: GSC corrected by the improved one-step-ahead Kalman filter",
     },
     MethodInfo {
+        name: "pf",
+        description: "MKPF paper baseline: bootstrap particle filter (500 particles), CV model",
+    },
+    MethodInfo {
+        name: "mkpf",
+        description: "MKPF paper: particle filter with a UKF+EKF proposal (50 particles), CV model",
+    },
+    MethodInfo {
         name: "hmm",
         description: "k-means motion states + HMM forward filter (K chosen on training data)",
     },
@@ -99,6 +107,14 @@ pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
             window: opts.window,
             horizons: opts.horizons,
             ..Default::default()
+        })?),
+        "pf" | "mkpf" => Box::new(ParticlePredictor::new(ParticleParams {
+            seed: opts.seed,
+            ..ParticleParams::new(if name == "pf" {
+                ParticleKind::Bootstrap
+            } else {
+                ParticleKind::Mkpf
+            })
         })?),
         "hmm" => Box::new(Hmm::new(HmmParams {
             seed: opts.seed,

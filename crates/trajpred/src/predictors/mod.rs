@@ -3,11 +3,13 @@
 mod gskf;
 mod hmm;
 mod kf_dynamic;
+mod particle;
 mod poly;
 
 pub use gskf::{Gsc, Gskf, GskfParams};
 pub use hmm::{Hmm, HmmParams};
 pub use kf_dynamic::{Continuation, KfDynamic, KfDynamicParams, NaiveKf};
+pub use particle::{ParticleKind, ParticleParams, ParticlePredictor};
 pub use poly::{PolyFit, PolyFitParams};
 
 use trajpred_core::{Error, Trajectory};
