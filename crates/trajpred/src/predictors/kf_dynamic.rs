@@ -2,7 +2,7 @@
 //! 13-15, iterated with the latest observation) and the "naive KF" (filter, then extrapolate
 //! `X(k+1) = A X(k)` without correction).
 
-use super::{invalid, step_interval};
+use super::{invalid, positions_forecast, step_interval};
 use nalgebra::{DMatrix, DVector, Dyn};
 use serde::{Deserialize, Serialize};
 use trajpred_core::{
@@ -142,18 +142,6 @@ fn build(params: &KfDynamicParams, history: &Trajectory, method: &str) -> Result
     Ok(Setup { kf, z, initial })
 }
 
-fn to_forecast(states: &[Gaussian<f64, Dyn>], d: usize) -> Result<Forecast> {
-    let means: Vec<Vec<f64>> = states
-        .iter()
-        .map(|g| g.mean.rows(0, d).iter().copied().collect())
-        .collect();
-    let covs = states
-        .iter()
-        .map(|g| g.covariance.view((0, 0), (d, d)).into_owned())
-        .collect();
-    Forecast::new(d, means)?.with_covariances(covs)
-}
-
 /// "KF dynamic" (SPEC B.1, eq. 13-15): the one-step-ahead predictor form of the Kalman
 /// filter, run through the history, then iterated `horizon` steps with the latest
 /// observation. The forecast carries the position covariance of every step.
@@ -206,7 +194,7 @@ impl Predictor for KfDynamic {
                 self.params.multi_step.into(),
             )
             .map_err(kalman_error(self.name()))?;
-        to_forecast(&states, history.dim())
+        positions_forecast(&states, history.dim())
     }
     fn min_history(&self) -> usize {
         2
@@ -250,7 +238,7 @@ impl Predictor for NaiveKf {
         let states = kf
             .forecast(last, horizon)
             .map_err(kalman_error(self.name()))?;
-        to_forecast(&states, history.dim())
+        positions_forecast(&states, history.dim())
     }
     fn min_history(&self) -> usize {
         2

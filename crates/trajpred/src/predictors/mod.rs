@@ -12,7 +12,22 @@ pub use kf_dynamic::{Continuation, KfDynamic, KfDynamicParams, NaiveKf};
 pub use particle::{ParticleKind, ParticleParams, ParticlePredictor};
 pub use poly::{PolyFit, PolyFitParams};
 
-use trajpred_core::{Error, Trajectory};
+use nalgebra::Dyn;
+use trajpred_core::{Error, Forecast, Gaussian, Result, Trajectory};
+
+/// The forecast of the first `d` state components (the positions, for `[positions,
+/// velocities]` states) of each predicted Gaussian, with their covariances.
+pub(crate) fn positions_forecast(states: &[Gaussian<f64, Dyn>], d: usize) -> Result<Forecast> {
+    let means: Vec<Vec<f64>> = states
+        .iter()
+        .map(|g| g.mean.rows(0, d).iter().copied().collect())
+        .collect();
+    let covs = states
+        .iter()
+        .map(|g| g.covariance.view((0, 0), (d, d)).into_owned())
+        .collect();
+    Forecast::new(d, means)?.with_covariances(covs)
+}
 
 pub(crate) fn invalid(name: &'static str, reason: impl Into<String>) -> Error {
     Error::InvalidParameter {

@@ -1,7 +1,7 @@
 //! Particle-filter predictors (SPEC C): the bootstrap particle filter and the MKPF
 //! (UKF + EKF proposal), with a constant-velocity model and position observations.
 
-use super::{invalid, step_interval};
+use super::{invalid, positions_forecast, step_interval};
 use nalgebra::{DMatrix, DVector, Dyn};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -93,6 +93,18 @@ fn particle_error(method: &'static str) -> impl Fn(trajpred_particle::ParticleEr
     move |e| Error::method(method, e)
 }
 
+/// Filters `z` with a freshly built particle filter, then forecasts `horizon` steps.
+fn run<F: ParticleFiltering<f64, Dyn, Dyn>>(
+    filter: trajpred_particle::Result<F>,
+    z: &[Option<DVector<f64>>],
+    horizon: usize,
+    rng: &mut ChaCha8Rng,
+) -> trajpred_particle::Result<Vec<Gaussian<f64, Dyn>>> {
+    let mut pf = filter?;
+    pf.filter(z, rng)?;
+    pf.forecast(horizon, rng)
+}
+
 fn kalman_error(method: &'static str) -> impl Fn(trajpred_kalman::KalmanError) -> Error {
     move |e| Error::method(method, e)
 }
@@ -137,45 +149,34 @@ impl Predictor for ParticlePredictor {
         let initial = Gaussian::new(x0, DMatrix::identity(n, n) * p.p0)?;
         let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
         let states = match p.kind {
-            ParticleKind::Bootstrap => {
-                let mut pf = ParticleFilter::from_gaussian(
+            ParticleKind::Bootstrap => run(
+                ParticleFilter::from_gaussian(
                     transition,
                     observation,
                     &initial,
                     p.particles,
                     &mut rng,
-                )
-                .map_err(particle_error(method))?;
-                pf.filter(&z[1..], &mut rng)
-                    .map_err(particle_error(method))?;
-                pf.forecast(horizon, &mut rng)
-                    .map_err(particle_error(method))?
-            }
-            ParticleKind::Mkpf => {
-                let mut pf = Mkpf::from_gaussian(
+                ),
+                &z[1..],
+                horizon,
+                &mut rng,
+            ),
+            ParticleKind::Mkpf => run(
+                Mkpf::from_gaussian(
                     transition,
                     observation,
                     &initial,
                     p.particles,
                     MerweSigmaPoints::default(),
                     &mut rng,
-                )
-                .map_err(particle_error(method))?;
-                pf.filter(&z[1..], &mut rng)
-                    .map_err(particle_error(method))?;
-                pf.forecast(horizon, &mut rng)
-                    .map_err(particle_error(method))?
-            }
-        };
-        let means: Vec<Vec<f64>> = states
-            .iter()
-            .map(|g| g.mean.rows(0, d).iter().copied().collect())
-            .collect();
-        let covs = states
-            .iter()
-            .map(|g| g.covariance.view((0, 0), (d, d)).into_owned())
-            .collect();
-        Forecast::new(d, means)?.with_covariances(covs)
+                ),
+                &z[1..],
+                horizon,
+                &mut rng,
+            ),
+        }
+        .map_err(particle_error(method))?;
+        positions_forecast(&states, d)
     }
 
     fn min_history(&self) -> usize {
