@@ -18,6 +18,8 @@ pub struct MethodOptions {
     pub window: usize,
     /// Horizons T the multi-step models are fitted for (the longest forecast they answer).
     pub horizons: usize,
+    /// Training epochs of the neural networks; `None` keeps each preset's (the papers').
+    pub epochs: Option<usize>,
 }
 
 impl Default for MethodOptions {
@@ -28,6 +30,7 @@ impl Default for MethodOptions {
             seed: 0,
             window: 6,
             horizons: 6,
+            epochs: None,
         }
     }
 }
@@ -85,9 +88,75 @@ pub const METHODS: &[MethodInfo] = &[
     },
 ];
 
+/// The neural methods (with the `neural` feature, on by default).
+#[cfg(feature = "neural")]
+pub const NEURAL_METHODS: &[MethodInfo] = &[
+    MethodInfo {
+        name: "bp",
+        description: "GSKF paper's BP: MLP (one hidden layer of 10), SGD lr 0.1, 500 epochs, per axis",
+    },
+    MethodInfo {
+        name: "lstm",
+        description: "GSKF paper's LSTM baseline: 2 x 64 LSTM + FC, lr 0.1, 500 epochs, per axis",
+    },
+    MethodInfo {
+        name: "rnn-patent",
+        description: "KFU-LSTM patent baseline: 2 x 64 RNN + FC, Adam lr 1e-3",
+    },
+    MethodInfo {
+        name: "lstm-patent",
+        description: "KFU-LSTM patent baseline: 2 x 64 LSTM + FC, Adam lr 1e-3",
+    },
+    MethodInfo {
+        name: "kfu-lstm",
+        description: "KFU-LSTM-Net: Kalman filter unfolded around a learned LSTM transition",
+    },
+];
+
+/// Every method this build knows: [`METHODS`] and, with the `neural` feature, the networks.
+pub fn all_methods() -> Vec<MethodInfo> {
+    let mut v = METHODS.to_vec();
+    #[cfg(feature = "neural")]
+    v.extend_from_slice(NEURAL_METHODS);
+    v
+}
+
+#[cfg(feature = "neural")]
+fn build_neural(name: &str, opts: &MethodOptions) -> Result<Option<Box<dyn Predictor>>> {
+    use trajpred_neural::{KfuLstmNet, LstmNet, Mlp, RnnNet};
+    let e = |err: trajpred_neural::NeuralError| Error::method(name.to_string(), err);
+    macro_rules! with_epochs {
+        ($net:expr) => {{
+            let mut net = $net.map_err(e)?;
+            if let Some(n) = opts.epochs {
+                let cfg = net.train_config().clone().with_epochs(n);
+                net.set_train_config(cfg).map_err(e)?;
+            }
+            Some(Box::new(net) as Box<dyn Predictor>)
+        }};
+    }
+    let (m, t) = (opts.window, opts.horizons);
+    Ok(match name {
+        "bp" => with_epochs!(Mlp::gskf_bp(m, t)),
+        "lstm" => with_epochs!(LstmNet::gskf_lstm(m, t)),
+        "rnn-patent" => with_epochs!(RnnNet::patent_baseline(m, t)),
+        "lstm-patent" => with_epochs!(LstmNet::patent_baseline(m, t)),
+        "kfu-lstm" => with_epochs!(KfuLstmNet::patent()),
+        _ => None,
+    })
+}
+
+#[cfg(not(feature = "neural"))]
+fn build_neural(_name: &str, _opts: &MethodOptions) -> Result<Option<Box<dyn Predictor>>> {
+    Ok(None)
+}
+
 /// Builds the predictor called `name` (see [`METHODS`]); an unknown name is an
 /// [`Error::InvalidParameter`] listing the known ones.
 pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
+    if let Some(p) = build_neural(name, opts)? {
+        return Ok(p);
+    }
     Ok(match name {
         "kf-dynamic" => Box::new(KfDynamic::new(KfDynamicParams::paper_position(opts.kf_q))?),
         "kf-dynamic-4d" => Box::new(KfDynamic::new(KfDynamicParams::paper_position_velocity(

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use trajpred::dataset::{self, Dataset, Prepare};
 use trajpred::harness::{EvalConfig, MethodReport, Split, fit_and_evaluate, split};
 use trajpred::plot::{Chart, Series, write_chart};
-use trajpred::registry::{METHODS, MethodOptions, build};
+use trajpred::registry::{MethodOptions, all_methods, build};
 use trajpred_core::{Forecast, Trajectory};
 
 #[derive(Parser)]
@@ -249,7 +249,7 @@ fn table(reports: &[MethodReport], format: Format) -> Result<String> {
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Methods => {
-            for m in METHODS {
+            for m in all_methods() {
                 println!("{:<16} {}", m.name, m.description);
             }
         }
