@@ -1,0 +1,224 @@
+//! # trajpred-repro
+//!
+//! The experiments of trajpred's four source papers, as data and runners. Each runner
+//! regenerates a paper's tables and figures with trajpred's own implementations and returns
+//! them with the paper's reported figure beside ours ([`report::Table`]), the paper's claims
+//! decided from the run ([`report::Claim`]) and notes on why numbers differ.
+//! `cargo xtask reproduce` is a thin command over [`run_paper`], [`report::write_paper`],
+//! [`report::write_index`] and [`report::compare_with_committed`].
+//!
+//! | paper | module | SPEC |
+//! |---|---|---|
+//! | MSTPM-GSKF (group sparse coding + improved KF) | [`papers::gskf`] | A.5 |
+//! | Dynamic trajectory prediction with a KF | [`papers::kf_dynamic`] | B.4 |
+//! | MKPF (particle filter, UKF+EKF proposal) | [`papers::mkpf`] | C.2 |
+//! | KFU-LSTM-Net (Kalman-filter-unfolded LSTM) | [`papers::kfu_lstm`] | D.2 |
+//!
+//! Synthetic experiments always run; the real-data ones read `Context::data_dir` (the layout of
+//! `../shared/data`: `geolife/`, `tdrive/`, `adsb-traffic/`) and, when it is absent, say what
+//! to download and where to put it while the rest still runs.
+#![forbid(unsafe_code)]
+
+pub mod error;
+pub mod papers;
+pub mod report;
+
+pub use error::{ReproError, Result};
+pub use report::{Claim, Column, ColumnKind, Figure, PaperResult, RunInfo, Table, Value};
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// One of the four papers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Paper {
+    /// MSTPM-GSKF: group sparse coding + improved Kalman filter (SPEC A).
+    Gskf,
+    /// Dynamic trajectory prediction with a Kalman filter (SPEC B).
+    KfDynamic,
+    /// MKPF: particle filter with a UKF+EKF proposal (SPEC C).
+    Mkpf,
+    /// KFU-LSTM-Net: a Kalman-filter-unfolded LSTM (SPEC D).
+    KfuLstm,
+}
+
+impl Paper {
+    /// The four papers, in SPEC order.
+    pub const ALL: [Paper; 4] = [Paper::Gskf, Paper::KfDynamic, Paper::Mkpf, Paper::KfuLstm];
+
+    /// The slug used on the command line and as the results folder name.
+    pub fn slug(self) -> &'static str {
+        match self {
+            Paper::Gskf => "gskf",
+            Paper::KfDynamic => "kf-dynamic",
+            Paper::Mkpf => "mkpf",
+            Paper::KfuLstm => "kfu-lstm",
+        }
+    }
+
+    /// The paper's title.
+    pub fn title(self) -> &'static str {
+        match self {
+            Paper::Gskf => {
+                "MSTPM-GSKF: multi-step prediction by group sparse coding and an improved Kalman filter (SPEC A)"
+            }
+            Paper::KfDynamic => "Dynamic trajectory prediction with a Kalman filter (SPEC B)",
+            Paper::Mkpf => "MKPF: a particle filter with a UKF+EKF proposal (SPEC C)",
+            Paper::KfuLstm => "KFU-LSTM-Net: a Kalman-filter-unfolded LSTM (SPEC D)",
+        }
+    }
+
+    /// Parses a slug.
+    pub fn from_slug(s: &str) -> Option<Paper> {
+        Paper::ALL.into_iter().find(|p| p.slug() == s)
+    }
+
+    /// Why this paper's numbers and ours can differ, for the results index (no numbers here:
+    /// those come from the run).
+    pub fn explanation(self) -> &'static str {
+        match self {
+            Paper::Gskf => papers::gskf::EXPLANATION,
+            Paper::KfDynamic => papers::kf_dynamic::EXPLANATION,
+            Paper::Mkpf => papers::mkpf::EXPLANATION,
+            Paper::KfuLstm => papers::kfu_lstm::EXPLANATION,
+        }
+    }
+}
+
+/// How to run: reduced or full, the seed, where the real data is, whether to draw progress.
+#[derive(Debug, Clone)]
+pub struct Context {
+    /// A reduced run (fewer seeds, epochs and trajectories) that finishes in under a minute.
+    pub quick: bool,
+    /// Base seed; every random choice of every experiment derives from it.
+    pub seed: u64,
+    /// Folder holding the real datasets (`geolife/`, `tdrive/`, `adsb-traffic/`), if any.
+    pub data_dir: Option<PathBuf>,
+    /// Draw progress bars on stderr.
+    pub progress: bool,
+}
+
+impl Default for Context {
+    fn default() -> Self {
+        Self {
+            quick: false,
+            seed: 20260611,
+            data_dir: None,
+            progress: false,
+        }
+    }
+}
+
+impl Context {
+    /// The folder of one real dataset (`geolife`, `tdrive`, `adsb-traffic`), when present.
+    pub fn data(&self, name: &str) -> Option<PathBuf> {
+        let dir = self.data_dir.as_ref()?.join(name);
+        dir.is_dir().then_some(dir)
+    }
+
+    /// The message recorded when a dataset is missing: what to download and where to put it.
+    pub fn missing(&self, name: &str, what: &str) -> String {
+        let place = self
+            .data_dir
+            .as_deref()
+            .unwrap_or(Path::new("../shared/data"))
+            .join(name);
+        format!(
+            "{what}: the {name} data was not found at {}; download it (see SOURCE.md of that \
+             folder in the project's shared data, or the dataset's public page) and put it \
+             there, or pass --data DIR",
+            place.display()
+        )
+    }
+
+    /// A progress bar (hidden unless `progress` is set).
+    pub fn bar(&self, len: u64, message: impl Into<String>) -> ProgressBar {
+        let bar = ProgressBar::with_draw_target(
+            Some(len),
+            if self.progress {
+                ProgressDrawTarget::stderr()
+            } else {
+                ProgressDrawTarget::hidden()
+            },
+        );
+        if let Ok(style) =
+            ProgressStyle::with_template("{msg:40} [{bar:30}] {pos}/{len} {elapsed_precise}")
+        {
+            bar.set_style(style.progress_chars("=> "));
+        }
+        bar.set_message(message.into());
+        bar
+    }
+}
+
+/// Runs one paper's experiments and returns its tables, figures, claims and notes, with the
+/// wall time in seconds.
+pub fn run_paper(paper: Paper, ctx: &Context) -> Result<(PaperResult, f64)> {
+    let start = Instant::now();
+    let result = match paper {
+        Paper::Gskf => papers::gskf::run(ctx),
+        Paper::KfDynamic => papers::kf_dynamic::run(ctx),
+        Paper::Mkpf => papers::mkpf::run(ctx),
+        Paper::KfuLstm => papers::kfu_lstm::run(ctx),
+    }?;
+    Ok((result, start.elapsed().as_secs_f64()))
+}
+
+/// The [`RunInfo`] of a finished run.
+pub fn run_info(
+    paper: Paper,
+    ctx: &Context,
+    result: &PaperResult,
+    wall_seconds: f64,
+    revision: &str,
+) -> RunInfo {
+    RunInfo {
+        paper: paper.slug().to_string(),
+        title: paper.title().to_string(),
+        seed: ctx.seed,
+        revision: revision.to_string(),
+        quick: ctx.quick,
+        wall_seconds,
+        data: result.data.clone(),
+        missing: result.missing.clone(),
+        claims: result.claims.clone(),
+        notes: result.notes.clone(),
+        tables: result
+            .tables
+            .iter()
+            .map(|t| (t.id.clone(), t.title.clone()))
+            .collect(),
+        figures: result
+            .figures
+            .iter()
+            .map(|f| (f.id.clone(), f.caption.clone()))
+            .collect(),
+    }
+}
+
+/// Runs `paper` and writes its results under `root/<slug>/`, then refreshes `root/README.md`.
+pub fn reproduce_into(paper: Paper, ctx: &Context, root: &Path, revision: &str) -> Result<RunInfo> {
+    let (result, wall) = run_paper(paper, ctx)?;
+    let info = run_info(paper, ctx, &result, wall, revision);
+    report::write_paper(&result, &info, &root.join(paper.slug()))?;
+    write_index(root)?;
+    Ok(info)
+}
+
+/// Rewrites the results index `root/README.md` from every paper's `run.json` under `root`.
+pub fn write_index(root: &Path) -> Result<()> {
+    let explanations: Vec<(&str, &str)> = Paper::ALL
+        .iter()
+        .map(|p| (p.slug(), p.explanation()))
+        .collect();
+    report::write_index(root, &explanations)
+}
+
+/// Runs `paper` and compares its tables with those committed under `root/<slug>/`; returns
+/// the fresh result and the differences (empty when it agrees within every column's tolerance).
+pub fn check_paper(paper: Paper, ctx: &Context, root: &Path) -> Result<(PaperResult, Vec<String>)> {
+    let (result, _) = run_paper(paper, ctx)?;
+    let diffs = report::compare_with_committed(&result.tables, &root.join(paper.slug()))?;
+    Ok((result, diffs))
+}
