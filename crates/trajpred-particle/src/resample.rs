@@ -76,29 +76,45 @@ fn check_weights(weights: &[f64]) -> Result<Checked> {
     if weights.is_empty() {
         return Err(ParticleError::Empty { what: "weights" });
     }
+    // Fast pass: the sequential sum (the `C_(N-1)` the cumulative sums of the merge passes
+    // end with) and a flag for negative weights; a NaN or infinite weight makes the sum
+    // non-finite. Only on failure is the first offending weight looked for.
     let mut total = 0.0f64;
-    let mut last = None;
-    for (index, &value) in weights.iter().enumerate() {
-        if !(value.is_finite() && value >= 0.0) {
-            return Err(ParticleError::InvalidWeight { index, value });
-        }
-        if value > 0.0 {
-            last = Some(index);
-        }
-        total += value;
+    let mut negative = false;
+    let chunks = weights.chunks_exact(4);
+    let rest = chunks.remainder();
+    for q in chunks {
+        total += q[0];
+        total += q[1];
+        total += q[2];
+        total += q[3];
+        negative |= (q[0] < 0.0) | (q[1] < 0.0) | (q[2] < 0.0) | (q[3] < 0.0);
     }
-    let Some(last) = last else {
-        return Err(ParticleError::AllWeightsZero {
+    for &v in rest {
+        total += v;
+        negative |= v < 0.0;
+    }
+    if negative || !total.is_finite() {
+        for (index, &value) in weights.iter().enumerate() {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(ParticleError::InvalidWeight { index, value });
+            }
+        }
+        if !total.is_finite() {
+            return Err(ParticleError::NonFinite {
+                what: "sum of weights",
+                index: 0,
+            });
+        }
+    }
+    // non-negative weights with a zero sum are all zero
+    let last = weights.iter().rposition(|&v| v > 0.0);
+    match last {
+        Some(last) if total > 0.0 => Ok(Checked { total, last }),
+        _ => Err(ParticleError::AllWeightsZero {
             count: weights.len(),
-        });
-    };
-    if !total.is_finite() {
-        return Err(ParticleError::NonFinite {
-            what: "sum of weights",
-            index: 0,
-        });
+        }),
     }
-    Ok(Checked { total, last })
 }
 
 fn check_uniform(index: usize, value: f64) -> Result<()> {
@@ -150,10 +166,82 @@ fn merge_sorted(
 pub fn systematic_indices(weights: &[f64], offset: f64, out: &mut [usize]) -> Result<()> {
     let c = check_weights(weights)?;
     check_uniform(0, offset)?;
-    let nf = out.len() as f64;
-    let total = c.total;
-    merge_sorted(weights, c.last, out, |j| (j as f64 + offset) / nf * total);
+    systematic_counts(weights, c, offset, out);
     Ok(())
+}
+
+/// How many slots [`fill_run`] writes unconditionally.
+const RUN: usize = 4;
+
+/// Writes `i` into `out[start..end]` (`start <= end <= out.len()`). Short runs (the common
+/// case: a resampled particle has a few copies) are written as a fixed-width store of
+/// [`RUN`] slots, without a data-dependent branch; the slots past `end` are overwritten by
+/// the next run or by the final fill of the caller, which must therefore write every slot
+/// from its last `end` to `out.len()`.
+#[inline(always)]
+fn fill_run(out: &mut [usize], start: usize, end: usize, i: usize) {
+    if end - start <= RUN && start + RUN <= out.len() {
+        out[start..start + RUN].fill(i);
+    } else {
+        out[start..end].fill(i);
+    }
+}
+
+/// `1.5 * 2^52`: adding it to `|x| < 2^51` rounds `x` to the nearest integer, held in the
+/// low bits of the sum.
+const ROUND: f64 = 6_755_399_441_055_744.0;
+
+/// For `e >= -1`: `(ceil(e), near)`, `near` when `e` lies within `margin` of an integer
+/// (where the estimate `e` may be off the exact count by one). Branch-free, no conversion
+/// instruction: `r`, the nearest integer, from the bits of `e + 1.5 * 2^52`.
+#[inline(always)]
+fn ceil_near(e: f64, margin: f64) -> (i64, bool) {
+    let y = e + ROUND;
+    let d = e - (y - ROUND);
+    let r = (y.to_bits() as i64).wrapping_sub(ROUND.to_bits() as i64);
+    (r + i64::from(d > 0.0), d.abs() < margin)
+}
+
+/// Systematic resampling as counts per input particle, in one pass over the weights.
+///
+/// The positions are `p_j = fl(fl(fl(j + u) / n) * W)` (the reference's operations, `W`
+/// the sequential sum); they are non-decreasing in `j`, so particle `i` receives the slots
+/// `k_(i-1) <= j < k_i` with `k_i = #{j : p_j < C_i}`. `k_i` is estimated as
+/// `ceil(C_i n / W - u)` (a multiplication, no division, no search); where that estimate is
+/// within `16 (n + 2) eps` of an integer (ties and near-ties, where rounding could move it
+/// by one; the estimate's error is below `4 (n + 1) eps`) it is corrected against the exact
+/// positions. The indices are therefore exactly those of the merge `C_(i-1) <= p_j < C_i`,
+/// without its data-dependent branch per particle; the slots from `k_last` on (positions at
+/// or past `C_last`) take `last`.
+fn systematic_counts(weights: &[f64], c: Checked, offset: f64, out: &mut [usize]) {
+    let n = out.len();
+    if n == 0 {
+        return;
+    }
+    let nf = n as f64;
+    let total = c.total;
+    let pos = |j: usize| (j as f64 + offset) / nf * total;
+    let scale = nf / total;
+    let margin = 16.0 * (nf + 2.0) * f64::EPSILON;
+    let mut start = 0usize;
+    let mut cum = 0.0f64;
+    for (i, &w) in weights[..=c.last].iter().enumerate() {
+        cum += w;
+        let (k, near) = ceil_near(cum * scale - offset, margin);
+        let mut k = k as usize;
+        if near {
+            k = (k as i64).clamp(start as i64, n as i64) as usize;
+            while k < n && pos(k) < cum {
+                k += 1;
+            }
+            while k > start && pos(k - 1) >= cum {
+                k -= 1;
+            }
+        }
+        fill_run(out, start, k, i);
+        start = k;
+    }
+    out[start..].fill(c.last);
 }
 
 /// Stratified resampling for given uniforms `u_j in [0, 1]` (one per output): positions
