@@ -191,15 +191,16 @@ fn fill_run(out: &mut [usize], start: usize, end: usize, i: usize) {
 /// low bits of the sum.
 const ROUND: f64 = 6_755_399_441_055_744.0;
 
-/// For `e >= -1`: `(ceil(e), near)`, `near` when `e` lies within `margin` of an integer
-/// (where the estimate `e` may be off the exact count by one). Branch-free, no conversion
-/// instruction: `r`, the nearest integer, from the bits of `e + 1.5 * 2^52`.
+/// For `h = e + 1/2` with `e >= -1`: `(ceil(e), near)`, `near` when `e` lies within
+/// `margin` of an integer (where `ceil(e)`, the nearest integer to `h`, may be off by one, and
+/// is `e` rounded to the nearest integer ties-to-even at `e` an integer). Branch-free and
+/// without a conversion instruction: the integer is read from the bits of `h + 1.5 * 2^52`.
 #[inline(always)]
-fn ceil_near(e: f64, margin: f64) -> (i64, bool) {
-    let y = e + ROUND;
-    let d = e - (y - ROUND);
-    let r = (y.to_bits() as i64).wrapping_sub(ROUND.to_bits() as i64);
-    (r + i64::from(d > 0.0), d.abs() < margin)
+fn ceil_near(h: f64, margin: f64) -> (usize, bool) {
+    let y = h + ROUND;
+    let d = (y - ROUND) - h;
+    let r = y.to_bits().wrapping_sub(ROUND.to_bits()) as usize;
+    (r, d.abs() > 0.5 - margin)
 }
 
 /// Systematic resampling as counts per input particle, in one pass over the weights.
@@ -223,12 +224,14 @@ fn systematic_counts(weights: &[f64], c: Checked, offset: f64, out: &mut [usize]
     let pos = |j: usize| (j as f64 + offset) / nf * total;
     let scale = nf / total;
     let margin = 16.0 * (nf + 2.0) * f64::EPSILON;
+    let half = 0.5 - offset;
+    // the fixed-width stores of the main loop need RUN slots from `start`
+    let lim = n.saturating_sub(RUN);
     let mut start = 0usize;
     let mut cum = 0.0f64;
     for (i, &w) in weights[..=c.last].iter().enumerate() {
         cum += w;
-        let (k, near) = ceil_near(cum * scale - offset, margin);
-        let mut k = k as usize;
+        let (mut k, near) = ceil_near(cum * scale + half, margin);
         if near {
             k = (k as i64).clamp(start as i64, n as i64) as usize;
             while k < n && pos(k) < cum {
@@ -238,7 +241,11 @@ fn systematic_counts(weights: &[f64], c: Checked, offset: f64, out: &mut [usize]
                 k -= 1;
             }
         }
-        fill_run(out, start, k, i);
+        if k.wrapping_sub(start) <= RUN && start <= lim && n >= RUN {
+            out[start..start + RUN].fill(i);
+        } else {
+            out[start..k].fill(i);
+        }
         start = k;
     }
     out[start..].fill(c.last);
@@ -325,7 +332,7 @@ pub fn residual_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) ->
     let c = check_weights(weights)?;
     let n = out.len();
     let scale = n as f64 / c.total;
-    let k = write_copies(weights, scale, out);
+    let (k, _, _) = write_copies(weights, scale, out);
     let m = n - k;
     if uniforms.len() < m {
         return Err(ParticleError::LengthMismatch {
@@ -362,20 +369,31 @@ pub fn residual_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) ->
     Ok(k)
 }
 
-/// Writes `floor(w_i * scale)` copies of each `i` (at most `out.len()` in total); returns
-/// how many were written.
+/// The deterministic part of residual resampling, in one pass: writes `floor(w_i * scale)`
+/// copies of each `i` in index order (at most `out.len()` in total; short runs as
+/// fixed-width stores, see [`fill_run`], so the slots from the returned count on hold
+/// scratch values the caller overwrites) and sums the residuals
+/// `w_i * scale - floor(w_i * scale)`. Returns (copies written, sum of the residuals, index of
+/// the last positive residual or 0).
 #[inline]
-fn write_copies(weights: &[f64], scale: f64, out: &mut [usize]) -> usize {
+fn write_copies(weights: &[f64], scale: f64, out: &mut [usize]) -> (usize, f64, usize) {
     let n = out.len();
     let mut k = 0usize;
+    let mut s = 0.0f64;
+    let mut last = 0usize;
     for (i, &w) in weights.iter().enumerate() {
-        // truncation is floor for x >= 0 (and one instruction, unlike `floor` without SSE4.1)
-        let copies = (w * scale) as usize;
+        let x = w * scale;
+        // truncation is floor for x >= 0 (one instruction, unlike `floor` without SSE4.1);
+        // x <= n (1 + eps) fits
+        let copies = x as i64 as usize;
+        let r = x - copies as f64;
+        s += r;
+        last = if r > 0.0 { i } else { last };
         let end = k.saturating_add(copies).min(n);
-        out[k..end].fill(i);
+        fill_run(out, k, end, i);
         k = end;
     }
-    k
+    (k, s, last)
 }
 
 fn fill_with_largest(weights: &[f64], out: &mut [usize]) {
@@ -549,27 +567,18 @@ impl Resampler for Residual {
         let c = check_weights(weights)?;
         let n = out.len();
         let scale = n as f64 / c.total;
-        let k = write_copies(weights, scale, out);
+        let (k, s, last) = write_copies(weights, scale, out);
         if k == n {
             return Ok(());
-        }
-        let residual = |i: usize| {
-            let x = weights[i] * scale;
-            x - (x as u64) as f64
-        };
-        let mut s = 0.0f64;
-        let mut last = 0usize;
-        for i in 0..weights.len() {
-            let r = residual(i);
-            if r > 0.0 {
-                last = i;
-            }
-            s += r;
         }
         if s <= 0.0 {
             fill_with_largest(weights, &mut out[k..]);
             return Ok(());
         }
+        let residual = |i: usize| {
+            let x = weights[i] * scale;
+            x - (x as i64) as f64
+        };
         sorted_multinomial(rng, residual, weights.len(), s, last, &mut out[k..]);
         Ok(())
     }
