@@ -191,10 +191,11 @@ fn fill_run(out: &mut [usize], start: usize, end: usize, i: usize) {
 /// low bits of the sum.
 const ROUND: f64 = 6_755_399_441_055_744.0;
 
-/// For `h = e + 1/2` with `e >= -1`: `(ceil(e), near)`, `near` when `e` lies within
-/// `margin` of an integer (where `ceil(e)`, the nearest integer to `h`, may be off by one, and
-/// is `e` rounded to the nearest integer ties-to-even at `e` an integer). Branch-free and
-/// without a conversion instruction: the integer is read from the bits of `h + 1.5 * 2^52`.
+/// For `h ~ e + 1/2` with `e >= -1`: returns the integer nearest to `h` (which is `ceil(e)`
+/// unless `e` is within a rounding error of an integer) and `near`, true when `h` lies
+/// within `margin` of a half-integer (`e` within `margin` of an integer: the caller then
+/// corrects the count exactly). Branch-free and without a conversion instruction: the
+/// integer is read from the bits of `h + 1.5 * 2^52`.
 #[inline(always)]
 fn ceil_near(h: f64, margin: f64) -> (usize, bool) {
     let y = h + ROUND;
