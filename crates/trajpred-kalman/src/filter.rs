@@ -4,7 +4,9 @@
 
 use crate::error::{KalmanError, Result};
 use crate::linalg::{
-    Chol, check_dim, check_finite, check_state, cholesky, mul, mul_tr, mul_vec, symmetrise,
+    Chol, check_dim, check_finite, check_square, check_state, cholesky, congruence_ldl, is_static,
+    joseph, state_finite_and_symmetric, mul, mul_vec, mul_tr_sym_plus,
+    symmetrise,
 };
 use crate::model::Observation;
 use nalgebra::allocator::Allocator;
@@ -305,16 +307,57 @@ where
     let n = state.mean.nrows();
     check_dim("F rows", n, f.nrows())?;
     check_dim("F columns", n, f.ncols())?;
-    let fp = mul(f, &state.covariance);
-    let mut p = mul_tr(&fp, f);
-    p += q;
-    symmetrise(&mut p);
+    // F P F^T + Q, symmetric by construction
+    let p = mul_tr_sym_plus(&mul(f, &state.covariance), f, q);
     check_finite(&mean, "predicted mean")?;
     check_finite(&p, "predicted covariance")?;
     Ok(Gaussian {
         mean,
         covariance: p,
     })
+}
+
+/// The prediction of the linear KF, `x' = F x`, `P' = F P F^T + Q`, with the input checks
+/// `checks`. With `factorise` and static sizes the definiteness check of `P` is the
+/// `L D L^T` factorisation from which `F P F^T` is then formed ([`congruence_ldl`]), so the
+/// full check costs no more than the cheap one; a `P` that is only semi-definite (or fails
+/// any check) takes the check `checks` of [`validate_state`] and the plain products. The
+/// caller passes the same `factorise` for `predict` and `predict_own_output`, so a batch
+/// and the same steps one by one give identical results.
+#[inline(always)]
+pub(crate) fn linear_predict<T, D>(
+    f: &OMatrix<T, D, D>,
+    state: &Gaussian<T, D>,
+    q: &OMatrix<T, D, D>,
+    n: usize,
+    factorise: bool,
+    checks: InputChecks,
+) -> Result<Gaussian<T, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    if factorise && is_static::<D, D>() {
+        check_dim("state mean", n, state.mean.nrows())?;
+        check_square(&state.covariance, n, "state covariance")?;
+        check_dim("F rows", n, f.nrows())?;
+        let fast_ok = state_finite_and_symmetric(state);
+        if let Some(p) = congruence_ldl(f, &state.covariance, q)
+            && fast_ok
+        {
+            let mean = mul_vec(f, &state.mean);
+            check_finite(&mean, "predicted mean")?;
+            check_finite(&p, "predicted covariance")?;
+            return Ok(Gaussian {
+                mean,
+                covariance: p,
+            });
+        }
+    }
+    validate_state(state, n, checks)?;
+    let mean = mul_vec(f, &state.mean);
+    linearized_predict(mean, f, state, q)
 }
 
 /// The update of a linearised observation model: `S = H P H^T + R`, `K = P H^T S^-1` by a
@@ -350,9 +393,8 @@ where
     let r = observation.observation_noise();
     let p = &prior.covariance;
     let hp = mul(h, p);
-    let mut s = mul_tr(&hp, h);
-    s += r;
-    symmetrise(&mut s);
+    // S = H P H^T + R, symmetric by construction
+    let s = mul_tr_sym_plus(&hp, h, r);
     let chol = cholesky(s.clone(), "S")?;
     // K^T = S^-1 H P (P symmetric)
     let mut kt = hp.clone();
@@ -361,23 +403,12 @@ where
     let y = observation.observation_residual(z, predicted_z);
     let mut mean = mul_vec(&gain, &y);
     mean += &prior.mean;
-    // Joseph form expanded: (I - K H) P (I - K H)^T + K R K^T
-    //   = P - K H P - (K H P)^T + K (H P H^T + R) K^T = P - A - A^T + K S K^T,
-    // algebraically equal for any gain K, in a third of the products
-    let a = mul(&gain, &hp);
     let mut cov = match form {
-        CovarianceUpdate::Joseph => {
-            let mut c = mul_tr(&mul(&gain, &s), &gain);
-            for j in 0..n {
-                for i in 0..n {
-                    c[(i, j)] += p[(i, j)] - a[(i, j)] - a[(j, i)];
-                }
-            }
-            c
-        }
-        CovarianceUpdate::Plain | CovarianceUpdate::Symmetrised => p - a,
+        // (I - K H) P (I - K H)^T + K R K^T from the products already formed; symmetric
+        CovarianceUpdate::Joseph => joseph(p, &gain, &hp, &s),
+        CovarianceUpdate::Plain | CovarianceUpdate::Symmetrised => p - mul(&gain, &hp),
     };
-    if form != CovarianceUpdate::Plain {
+    if form == CovarianceUpdate::Symmetrised {
         symmetrise(&mut cov);
     }
     let log_likelihood = gaussian_log_likelihood(&chol, &y);

@@ -5,7 +5,7 @@
 use crate::error::Result;
 use crate::filter::{
     CovarianceUpdate, Filter, InputChecks, PredictionWithCross, Smoother, Update,
-    linearized_predict, linearized_update, validate_state,
+    linear_predict, linearized_predict, linearized_update, validate_state,
 };
 use crate::linalg::{check_dim, mul_vec};
 use crate::model::{
@@ -114,17 +114,25 @@ where
 {
     #[inline(always)]
     fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
-        validate_state(state, self.transition.state_dim(), self.checks)?;
-        let f = self.transition.transition_matrix();
-        let mean = mul_vec(f, &state.mean);
-        linearized_predict(mean, f, state, self.transition.process_noise())
+        linear_predict(
+            self.transition.transition_matrix(),
+            state,
+            self.transition.process_noise(),
+            self.transition.state_dim(),
+            self.checks == InputChecks::Full,
+            self.checks,
+        )
     }
 
     fn predict_own_output(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
-        validate_state(state, self.transition.state_dim(), InputChecks::Cheap)?;
-        let f = self.transition.transition_matrix();
-        let mean = mul_vec(f, &state.mean);
-        linearized_predict(mean, f, state, self.transition.process_noise())
+        linear_predict(
+            self.transition.transition_matrix(),
+            state,
+            self.transition.process_noise(),
+            self.transition.state_dim(),
+            self.checks == InputChecks::Full,
+            InputChecks::Cheap,
+        )
     }
 
     fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>> {

@@ -61,40 +61,19 @@ where
     if is_static::<R, K>() && is_static::<K, C>() && K::try_to_usize() != Some(0) {
         let (r, k) = a.shape_generic();
         let c = b.shape_generic().1;
-        OMatrix::<T, R, C>::from_fn_generic(r, c, |i, j| {
-            let mut acc = a[(i, 0)] * b[(0, j)];
-            for l in 1..k.value() {
-                acc += a[(i, l)] * b[(l, j)];
+        // column axpy order (i innermost, contiguous in column-major storage): vectorises
+        let mut out = OMatrix::<T, R, C>::zeros_generic(r, c);
+        for j in 0..c.value() {
+            for l in 0..k.value() {
+                let blj = b[(l, j)];
+                for i in 0..r.value() {
+                    out[(i, j)] += a[(i, l)] * blj;
+                }
             }
-            acc
-        })
+        }
+        out
     } else {
         a * b
-    }
-}
-
-/// The product `a b^T` (same strategy as [`mul`]).
-#[inline(always)]
-pub(crate) fn mul_tr<T, R, K, C>(a: &OMatrix<T, R, K>, b: &OMatrix<T, C, K>) -> OMatrix<T, R, C>
-where
-    T: RealField + Copy,
-    R: Dim,
-    K: Dim,
-    C: Dim,
-    DefaultAllocator: Allocator<R, K> + Allocator<C, K> + Allocator<K, C> + Allocator<R, C>,
-{
-    if is_static::<R, K>() && is_static::<K, C>() && K::try_to_usize() != Some(0) {
-        let (r, k) = a.shape_generic();
-        let c = b.shape_generic().0;
-        OMatrix::<T, R, C>::from_fn_generic(r, c, |i, j| {
-            let mut acc = a[(i, 0)] * b[(j, 0)];
-            for l in 1..k.value() {
-                acc += a[(i, l)] * b[(j, l)];
-            }
-            acc
-        })
-    } else {
-        a * b.transpose()
     }
 }
 
@@ -109,16 +88,174 @@ where
 {
     if is_static::<R, K>() && K::try_to_usize() != Some(0) {
         let (r, k) = a.shape_generic();
-        OVector::<T, R>::from_fn_generic(r, Const::<1>, |i, _| {
-            let mut acc = a[(i, 0)] * v[0];
-            for l in 1..k.value() {
-                acc += a[(i, l)] * v[l];
+        let mut out = OVector::<T, R>::zeros_generic(r, Const::<1>);
+        for l in 0..k.value() {
+            let vl = v[l];
+            for i in 0..r.value() {
+                out[i] += a[(i, l)] * vl;
             }
-            acc
-        })
+        }
+        out
     } else {
         a * v
     }
+}
+
+/// `x a^T + (c + c^T) / 2` for a product `x a^T` that is symmetric in exact arithmetic
+/// (`x = a b` with `b` symmetric): for static sizes only the lower triangle is formed and
+/// then mirrored, so the result is exactly symmetric without a separate symmetrisation
+/// pass; run-time sizes use nalgebra's product and [`symmetrise`].
+#[inline(always)]
+pub(crate) fn mul_tr_sym_plus<T, R, K>(
+    x: &OMatrix<T, R, K>,
+    a: &OMatrix<T, R, K>,
+    c: &OMatrix<T, R, R>,
+) -> OMatrix<T, R, R>
+where
+    T: RealField + Copy,
+    R: Dim,
+    K: Dim,
+    DefaultAllocator: Allocator<R, K> + Allocator<K, R> + Allocator<R, R>,
+{
+    if is_static::<R, K>() && K::try_to_usize() != Some(0) {
+        let (r, k) = a.shape_generic();
+        let half = nalgebra::convert::<f64, T>(0.5);
+        let mut out = OMatrix::<T, R, R>::zeros_generic(r, r);
+        // lower triangle, column by column with i innermost (contiguous): vectorises
+        for j in 0..r.value() {
+            for i in j..r.value() {
+                out[(i, j)] = (c[(i, j)] + c[(j, i)]) * half;
+            }
+            for l in 0..k.value() {
+                let ajl = a[(j, l)];
+                for i in j..r.value() {
+                    out[(i, j)] += x[(i, l)] * ajl;
+                }
+            }
+        }
+        for j in 0..r.value() {
+            for i in 0..j {
+                out[(i, j)] = out[(j, i)];
+            }
+        }
+        out
+    } else {
+        let mut out = x * a.transpose() + c;
+        symmetrise(&mut out);
+        out
+    }
+}
+
+/// The Joseph form `(I - K H) P (I - K H)^T + K R K^T` from `HP`, the gain `K` and
+/// `S = H P H^T + R` (symmetric), for any gain `K`. Expanding the product gives
+/// `P - K (HP) - (HP)^T K^T + K S K^T`, which equals `P + U K^T + K U^T` with
+/// `U = K S / 2 - (HP)^T` (an `n x m` matrix): for static sizes only the lower triangle of
+/// that sum is formed (with `(P + P^T) / 2`) and mirrored, so the result is exactly
+/// symmetric; run-time sizes use nalgebra's products and [`symmetrise`].
+#[inline(always)]
+pub(crate) fn joseph<T, D, M>(
+    p: &OMatrix<T, D, D>,
+    k: &OMatrix<T, D, M>,
+    hp: &OMatrix<T, M, D>,
+    s: &OMatrix<T, M, M>,
+) -> OMatrix<T, D, D>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    DefaultAllocator:
+        Allocator<D, D> + Allocator<D, M> + Allocator<M, D> + Allocator<M, M>,
+{
+    if is_static::<D, M>() && M::try_to_usize() != Some(0) {
+        let (d, m) = k.shape_generic();
+        let half = nalgebra::convert::<f64, T>(0.5);
+        let ks = mul(k, s);
+        let u = OMatrix::<T, D, M>::from_fn_generic(d, m, |i, a| ks[(i, a)] * half - hp[(a, i)]);
+        let mut out = OMatrix::<T, D, D>::zeros_generic(d, d);
+        // lower triangle, column by column with i innermost (contiguous): vectorises
+        for j in 0..d.value() {
+            for i in j..d.value() {
+                out[(i, j)] = (p[(i, j)] + p[(j, i)]) * half;
+            }
+            for a in 0..m.value() {
+                let (kja, uja) = (k[(j, a)], u[(j, a)]);
+                for i in j..d.value() {
+                    out[(i, j)] += u[(i, a)] * kja + k[(i, a)] * uja;
+                }
+            }
+        }
+        for j in 0..d.value() {
+            for i in 0..j {
+                out[(i, j)] = out[(j, i)];
+            }
+        }
+        out
+    } else {
+        let a = k * hp;
+        let mut c = k * s * k.transpose();
+        c += p;
+        c -= &a;
+        c -= a.transpose();
+        symmetrise(&mut c);
+        c
+    }
+}
+
+/// `F P F^T + (Q + Q^T) / 2` through the factorisation `P = L D L^T` (`L` unit lower
+/// triangular), which doubles as the check that `P` is positive definite: `None` when a
+/// pivot `d_j` is not strictly positive and finite (a semi-definite, indefinite or
+/// non-finite `P`; the caller then takes the exact check). Otherwise `M = F L` and the lower
+/// triangle of `M D M^T + Q`, mirrored: the same cost as the two products of `F P F^T`
+/// alone, so the definiteness check is free. Reads the lower triangle of `P` only (the caller
+/// checks symmetry). Static sizes only (the loops are meant to be unrolled).
+#[inline(always)]
+pub(crate) fn congruence_ldl<T, D>(
+    f: &OMatrix<T, D, D>,
+    p: &OMatrix<T, D, D>,
+    q: &OMatrix<T, D, D>,
+) -> Option<OMatrix<T, D, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D> + Allocator<D>,
+{
+    let (dd, _) = p.shape_generic();
+    let n = dd.value();
+    // L D L^T in place: L below the diagonal of `l`, D in `d`
+    let mut l = p.clone();
+    let mut d = OVector::<T, D>::zeros_generic(dd, Const::<1>);
+    let mut ok = true;
+    for j in 0..n {
+        let mut dj = l[(j, j)];
+        for k in 0..j {
+            dj -= l[(j, k)] * l[(j, k)] * d[k];
+        }
+        ok &= dj > T::zero() && dj.is_finite();
+        d[j] = dj;
+        let inv = T::one() / dj;
+        for i in (j + 1)..n {
+            let mut s = l[(i, j)];
+            for k in 0..j {
+                s -= l[(i, k)] * l[(j, k)] * d[k];
+            }
+            l[(i, j)] = s * inv;
+        }
+    }
+    if !ok {
+        return None;
+    }
+    // M = F L (L unit lower triangular), then MD = M diag(d)
+    let mut m = f.clone();
+    for j in 0..n {
+        for k in (j + 1)..n {
+            let lkj = l[(k, j)];
+            for i in 0..n {
+                m[(i, j)] += f[(i, k)] * lkj;
+            }
+        }
+    }
+    let md = OMatrix::<T, D, D>::from_fn_generic(dd, dd, |i, k| m[(i, k)] * d[k]);
+    Some(mul_tr_sym_plus(&md, &m, q))
 }
 
 /// Errors with [`KalmanError::DimensionMismatch`] unless `got == expected`.
@@ -348,6 +485,26 @@ where
         ok &= m[(j, j)] >= T::zero();
         for i in 0..j {
             ok &= (m[(i, j)] - m[(j, i)]).abs() <= tol;
+        }
+    }
+    ok
+}
+
+/// The fast part of [`check_state`] for the factorising predict: finite mean and `P`, `P`
+/// symmetric to [`symmetry_tolerance`] (definiteness is left to the factorisation).
+#[inline(always)]
+pub(crate) fn state_finite_and_symmetric<T, D>(state: &Gaussian<T, D>) -> bool
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    let p = &state.covariance;
+    let tol = symmetry_tolerance(amax_finite(p));
+    let mut ok = all_finite(&state.mean) & all_finite(p);
+    for j in 0..p.nrows() {
+        for i in 0..j {
+            ok &= (p[(i, j)] - p[(j, i)]).abs() <= tol;
         }
     }
     ok

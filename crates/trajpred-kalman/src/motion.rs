@@ -274,6 +274,37 @@ impl<T: RealField + Copy> CoordinatedTurn<T> {
         })
     }
 
+    /// `(sin(wT)/w, (1-cos(wT))/w, cos(wT), sin(wT))`: the part of
+    /// [`CoordinatedTurn::coefficients`] that `f(x)` needs (the same expressions, without the
+    /// derivatives and their divisions; the UKF calls it for every sigma point).
+    #[inline(always)]
+    fn transition_coefficients(&self, w: T) -> [T; 4] {
+        let t = self.dt;
+        let wt = w * t;
+        let (s, c) = wt.sin_cos();
+        let k = |v: f64| nalgebra::convert::<f64, T>(v);
+        if wt.abs() < k(1e-2) {
+            let x = wt;
+            let x2 = x * x;
+            [
+                t * (T::one()
+                    - x2 / k(6.0) * (T::one() - x2 / k(20.0) * (T::one() - x2 / k(42.0)))),
+                t * x
+                    * (k(0.5)
+                        - x2 / k(24.0) * (T::one() - x2 / k(30.0) * (T::one() - x2 / k(56.0)))),
+                c,
+                s,
+            ]
+        } else {
+            let one_minus_c = if c > T::zero() {
+                s * s / (T::one() + c)
+            } else {
+                T::one() - c
+            };
+            [s / w, one_minus_c / w, c, s]
+        }
+    }
+
     /// `(sin(wT)/w, (1-cos(wT))/w, d/dw of both, cos(wT), sin(wT))`.
     fn coefficients(&self, w: T) -> [T; 6] {
         let t = self.dt;
@@ -319,7 +350,7 @@ impl<T: RealField + Copy> CoordinatedTurn<T> {
 
 impl<T: RealField + Copy> Transition<T, U5> for CoordinatedTurn<T> {
     fn transition(&self, x: &Vector5<T>) -> Result<Vector5<T>> {
-        let [a, b, _, _, c, s] = self.coefficients(x[4]);
+        let [a, b, c, s] = self.transition_coefficients(x[4]);
         let (vx, vy) = (x[1], x[3]);
         Ok(Vector5::new(
             x[0] + a * vx - b * vy,

@@ -6,7 +6,7 @@ use crate::filter::{
     Filter, InputChecks, PredictionWithCross, Smoother, Update, gaussian_log_likelihood,
     validate_state,
 };
-use crate::linalg::{check_dim, check_finite, cholesky, symmetrise};
+use crate::linalg::{check_dim, check_finite, cholesky, mul, mul_tr_sym_plus, mul_vec, symmetrise};
 use crate::model::{Observation, Transition, validate_models};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
@@ -193,33 +193,64 @@ where
     let y0 = g(&state.mean)?;
     let e = y0.shape_generic().0;
     let d = state.mean.shape_generic().0;
+    let ne = e.value();
     let mut plus = OMatrix::<T, E, D>::zeros_generic(e, d);
     let mut minus = OMatrix::<T, E, D>::zeros_generic(e, d);
     let mut sum = OVector::<T, E>::zeros_generic(e, nalgebra::Const::<1>);
+    // one sigma point buffer on the stack (static sizes); L is lower triangular, so the
+    // points x +- L_j differ from x only in rows j..n
+    let mut x = state.mean.clone();
     for j in 0..n {
-        let xp = &state.mean + l.column(j);
-        let yp = g(&xp)?;
-        check_dim("transformed sigma point", e.value(), yp.nrows())?;
+        for i in j..n {
+            x[i] = state.mean[i] + l[(i, j)];
+        }
+        let yp = g(&x)?;
+        check_dim("transformed sigma point", ne, yp.nrows())?;
         sum += residual(&yp, &y0);
         plus.set_column(j, &yp);
-        let xm = &state.mean - l.column(j);
-        let ym = g(&xm)?;
-        check_dim("transformed sigma point", e.value(), ym.nrows())?;
+        for i in j..n {
+            x[i] = state.mean[i] - l[(i, j)];
+        }
+        let ym = g(&x)?;
+        check_dim("transformed sigma point", ne, ym.nrows())?;
         sum += residual(&ym, &y0);
         minus.set_column(j, &ym);
+        for i in j..n {
+            x[i] = state.mean[i];
+        }
     }
     let mean = &y0 + sum * w.other;
-    let r0 = residual(&y0, &mean);
+    // the weighted spread: lower triangle accumulated column by column, then mirrored
     let mut covariance = OMatrix::<T, E, E>::zeros_generic(e, e);
-    covariance.ger(w.covariance0, &r0, &r0, T::zero());
+    let r0 = residual(&y0, &mean);
+    for b in 0..ne {
+        let wb = r0[b] * w.covariance0;
+        for a in b..ne {
+            covariance[(a, b)] = r0[a] * wb;
+        }
+    }
     let mut cross = OMatrix::<T, D, E>::zeros_generic(d, e);
     for j in 0..n {
         let rp = residual(&plus.column(j).into_owned(), &mean);
         let rm = residual(&minus.column(j).into_owned(), &mean);
-        covariance.ger(w.other, &rp, &rp, T::one());
-        covariance.ger(w.other, &rm, &rm, T::one());
+        for b in 0..ne {
+            let (pb, mb) = (rp[b] * w.other, rm[b] * w.other);
+            for a in b..ne {
+                covariance[(a, b)] += rp[a] * pb + rm[a] * mb;
+            }
+        }
         if with_cross {
-            cross.ger(w.other, &l.column(j), &(rp - rm), T::one());
+            for b in 0..ne {
+                let db = (rp[b] - rm[b]) * w.other;
+                for i in j..n {
+                    cross[(i, b)] += l[(i, j)] * db;
+                }
+            }
+        }
+    }
+    for b in 0..ne {
+        for a in 0..b {
+            covariance[(a, b)] = covariance[(b, a)];
         }
     }
     Ok(Transformed {
@@ -345,9 +376,11 @@ where
         chol.solve_mut(&mut kt);
         let gain = kt.transpose();
         let y = ob.observation_residual(z, &z_hat);
-        let mean = &prior.mean + &gain * &y;
-        let mut cov = &prior.covariance - &gain * &s * gain.transpose();
-        symmetrise(&mut cov);
+        let mut mean = mul_vec(&gain, &y);
+        mean += &prior.mean;
+        // P - K S K^T, lower triangle mirrored (symmetric)
+        let neg_ks = -mul(&gain, &s);
+        let cov = mul_tr_sym_plus(&neg_ks, &gain, &prior.covariance);
         let log_likelihood = gaussian_log_likelihood(&chol, &y);
         check_finite(&mean, "posterior mean")?;
         check_finite(&cov, "posterior covariance")?;

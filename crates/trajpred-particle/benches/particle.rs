@@ -5,6 +5,11 @@
 //!   beside `resample/baseline_sum/<N>`, one pass summing the weights, to calibrate the
 //!   figures on a shared machine;
 //!   filterpy's figures for the same sizes come from `benches/filterpy_resampling.py`;
+//!   the input is *linear, unnormalised* weights (the resamplers divide by the sum);
+//! - `resample_from_log/<scheme>/<N>`: what a filter step does before resampling, from
+//!   log-weights (i.i.d. `ln U`): `weights_from_log_into` (log-sum-exp, then one `exp` per
+//!   particle into a caller's buffer), then the resampler; the difference to `resample/`
+//!   is the log-to-linear conversion;
 //! - `step/bootstrap_ct5_rb2/1000` and `step/mkpf_ct5_rb2/100`: one filter step on the
 //!   coordinated-turn + range-bearing model (throughput: particles per second, so the time
 //!   per particle is the inverse).
@@ -16,7 +21,9 @@ use rand::{RngExt, SeedableRng};
 use std::hint::black_box;
 use trajpred_core::Gaussian;
 use trajpred_kalman::{CoordinatedTurn, MerweSigmaPoints, Observation, RangeBearing};
-use trajpred_particle::{Mkpf, ParticleFilter, ParticleFiltering, Resampler, Resampling};
+use trajpred_particle::{
+    Mkpf, ParticleFilter, ParticleFiltering, Resampler, Resampling, weights_from_log_into,
+};
 
 fn resamplers(c: &mut Criterion) {
     let mut group = c.benchmark_group("resample");
@@ -36,6 +43,27 @@ fn resamplers(c: &mut Criterion) {
                 b.iter(|| {
                     scheme
                         .resample_into(black_box(&weights), &mut rng, &mut out)
+                        .expect("resample");
+                    black_box(&out);
+                })
+            });
+        }
+    }
+    group.finish();
+    let mut group = c.benchmark_group("resample_from_log");
+    for &n in &[10_000usize, 1_000_000] {
+        let mut wrng = SmallRng::seed_from_u64(1);
+        let log_weights: Vec<f64> = (0..n).map(|_| wrng.random::<f64>().ln()).collect();
+        let mut w = vec![0.0f64; n];
+        let mut out = vec![0usize; n];
+        group.throughput(Throughput::Elements(n as u64));
+        for scheme in [Resampling::Residual, Resampling::Systematic] {
+            let mut rng = SmallRng::seed_from_u64(2);
+            group.bench_with_input(BenchmarkId::new(scheme.name(), n), &n, |b, _| {
+                b.iter(|| {
+                    weights_from_log_into(black_box(&log_weights), &mut w).expect("exp");
+                    scheme
+                        .resample_into(&w, &mut rng, &mut out)
                         .expect("resample");
                     black_box(&out);
                 })

@@ -76,29 +76,45 @@ fn check_weights(weights: &[f64]) -> Result<Checked> {
     if weights.is_empty() {
         return Err(ParticleError::Empty { what: "weights" });
     }
+    // Fast pass: the sequential sum (the `C_(N-1)` the cumulative sums of the merge passes
+    // end with) and a flag for negative weights; a NaN or infinite weight makes the sum
+    // non-finite. Only on failure is the first offending weight looked for.
     let mut total = 0.0f64;
-    let mut last = None;
-    for (index, &value) in weights.iter().enumerate() {
-        if !(value.is_finite() && value >= 0.0) {
-            return Err(ParticleError::InvalidWeight { index, value });
-        }
-        if value > 0.0 {
-            last = Some(index);
-        }
-        total += value;
+    let mut negative = false;
+    let chunks = weights.chunks_exact(4);
+    let rest = chunks.remainder();
+    for q in chunks {
+        total += q[0];
+        total += q[1];
+        total += q[2];
+        total += q[3];
+        negative |= (q[0] < 0.0) | (q[1] < 0.0) | (q[2] < 0.0) | (q[3] < 0.0);
     }
-    let Some(last) = last else {
-        return Err(ParticleError::AllWeightsZero {
+    for &v in rest {
+        total += v;
+        negative |= v < 0.0;
+    }
+    if negative || !total.is_finite() {
+        for (index, &value) in weights.iter().enumerate() {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(ParticleError::InvalidWeight { index, value });
+            }
+        }
+        if !total.is_finite() {
+            return Err(ParticleError::NonFinite {
+                what: "sum of weights",
+                index: 0,
+            });
+        }
+    }
+    // non-negative weights with a zero sum are all zero
+    let last = weights.iter().rposition(|&v| v > 0.0);
+    match last {
+        Some(last) if total > 0.0 => Ok(Checked { total, last }),
+        _ => Err(ParticleError::AllWeightsZero {
             count: weights.len(),
-        });
-    };
-    if !total.is_finite() {
-        return Err(ParticleError::NonFinite {
-            what: "sum of weights",
-            index: 0,
-        });
+        }),
     }
-    Ok(Checked { total, last })
 }
 
 fn check_uniform(index: usize, value: f64) -> Result<()> {
@@ -150,10 +166,90 @@ fn merge_sorted(
 pub fn systematic_indices(weights: &[f64], offset: f64, out: &mut [usize]) -> Result<()> {
     let c = check_weights(weights)?;
     check_uniform(0, offset)?;
-    let nf = out.len() as f64;
-    let total = c.total;
-    merge_sorted(weights, c.last, out, |j| (j as f64 + offset) / nf * total);
+    systematic_counts(weights, c, offset, out);
     Ok(())
+}
+
+/// How many slots [`fill_run`] writes unconditionally.
+const RUN: usize = 4;
+
+/// Writes `i` into `out[start..end]` (`start <= end <= out.len()`). Short runs (the common
+/// case: a resampled particle has a few copies) are written as a fixed-width store of
+/// [`RUN`] slots, without a data-dependent branch; the slots past `end` are overwritten by
+/// the next run or by the final fill of the caller, which must therefore write every slot
+/// from its last `end` to `out.len()`.
+#[inline(always)]
+fn fill_run(out: &mut [usize], start: usize, end: usize, i: usize) {
+    if end - start <= RUN && start + RUN <= out.len() {
+        out[start..start + RUN].fill(i);
+    } else {
+        out[start..end].fill(i);
+    }
+}
+
+/// `1.5 * 2^52`: adding it to `|x| < 2^51` rounds `x` to the nearest integer, held in the
+/// low bits of the sum.
+const ROUND: f64 = 6_755_399_441_055_744.0;
+
+/// For `h ~ e + 1/2` with `e >= -1`: returns the integer nearest to `h` (which is `ceil(e)`
+/// unless `e` is within a rounding error of an integer) and `near`, true when `h` lies
+/// within `margin` of a half-integer (`e` within `margin` of an integer: the caller then
+/// corrects the count exactly). Branch-free and without a conversion instruction: the
+/// integer is read from the bits of `h + 1.5 * 2^52`.
+#[inline(always)]
+fn ceil_near(h: f64, margin: f64) -> (usize, bool) {
+    let y = h + ROUND;
+    let d = (y - ROUND) - h;
+    let r = y.to_bits().wrapping_sub(ROUND.to_bits()) as usize;
+    (r, d.abs() > 0.5 - margin)
+}
+
+/// Systematic resampling as counts per input particle, in one pass over the weights.
+///
+/// The positions are `p_j = fl(fl(fl(j + u) / n) * W)` (the reference's operations, `W`
+/// the sequential sum); they are non-decreasing in `j`, so particle `i` receives the slots
+/// `k_(i-1) <= j < k_i` with `k_i = #{j : p_j < C_i}`. `k_i` is estimated as
+/// `ceil(C_i n / W - u)` (a multiplication, no division, no search); where that estimate is
+/// within `16 (n + 2) eps` of an integer (ties and near-ties, where rounding could move it
+/// by one; the estimate's error is below `4 (n + 1) eps`) it is corrected against the exact
+/// positions. The indices are therefore exactly those of the merge `C_(i-1) <= p_j < C_i`,
+/// without its data-dependent branch per particle; the slots from `k_last` on (positions at
+/// or past `C_last`) take `last`.
+fn systematic_counts(weights: &[f64], c: Checked, offset: f64, out: &mut [usize]) {
+    let n = out.len();
+    if n == 0 {
+        return;
+    }
+    let nf = n as f64;
+    let total = c.total;
+    let pos = |j: usize| (j as f64 + offset) / nf * total;
+    let scale = nf / total;
+    let margin = 16.0 * (nf + 2.0) * f64::EPSILON;
+    let half = 0.5 - offset;
+    // the fixed-width stores of the main loop need RUN slots from `start`
+    let lim = n.saturating_sub(RUN);
+    let mut start = 0usize;
+    let mut cum = 0.0f64;
+    for (i, &w) in weights[..=c.last].iter().enumerate() {
+        cum += w;
+        let (mut k, near) = ceil_near(cum * scale + half, margin);
+        if near {
+            k = (k as i64).clamp(start as i64, n as i64) as usize;
+            while k < n && pos(k) < cum {
+                k += 1;
+            }
+            while k > start && pos(k - 1) >= cum {
+                k -= 1;
+            }
+        }
+        if k.wrapping_sub(start) <= RUN && start <= lim && n >= RUN {
+            out[start..start + RUN].fill(i);
+        } else {
+            out[start..k].fill(i);
+        }
+        start = k;
+    }
+    out[start..].fill(c.last);
 }
 
 /// Stratified resampling for given uniforms `u_j in [0, 1]` (one per output): positions
@@ -237,7 +333,7 @@ pub fn residual_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) ->
     let c = check_weights(weights)?;
     let n = out.len();
     let scale = n as f64 / c.total;
-    let k = write_copies(weights, scale, out);
+    let (k, _, _) = write_copies(weights, scale, out);
     let m = n - k;
     if uniforms.len() < m {
         return Err(ParticleError::LengthMismatch {
@@ -274,20 +370,31 @@ pub fn residual_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) ->
     Ok(k)
 }
 
-/// Writes `floor(w_i * scale)` copies of each `i` (at most `out.len()` in total); returns
-/// how many were written.
+/// The deterministic part of residual resampling, in one pass: writes `floor(w_i * scale)`
+/// copies of each `i` in index order (at most `out.len()` in total; short runs as
+/// fixed-width stores, see [`fill_run`], so the slots from the returned count on hold
+/// scratch values the caller overwrites) and sums the residuals
+/// `w_i * scale - floor(w_i * scale)`. Returns (copies written, sum of the residuals, index of
+/// the last positive residual or 0).
 #[inline]
-fn write_copies(weights: &[f64], scale: f64, out: &mut [usize]) -> usize {
+fn write_copies(weights: &[f64], scale: f64, out: &mut [usize]) -> (usize, f64, usize) {
     let n = out.len();
     let mut k = 0usize;
+    let mut s = 0.0f64;
+    let mut last = 0usize;
     for (i, &w) in weights.iter().enumerate() {
-        // truncation is floor for x >= 0 (and one instruction, unlike `floor` without SSE4.1)
-        let copies = (w * scale) as usize;
+        let x = w * scale;
+        // truncation is floor for x >= 0 (one instruction, unlike `floor` without SSE4.1);
+        // x <= n (1 + eps) fits
+        let copies = x as i64 as usize;
+        let r = x - copies as f64;
+        s += r;
+        last = if r > 0.0 { i } else { last };
         let end = k.saturating_add(copies).min(n);
-        out[k..end].fill(i);
+        fill_run(out, k, end, i);
         k = end;
     }
-    k
+    (k, s, last)
 }
 
 fn fill_with_largest(weights: &[f64], out: &mut [usize]) {
@@ -461,27 +568,18 @@ impl Resampler for Residual {
         let c = check_weights(weights)?;
         let n = out.len();
         let scale = n as f64 / c.total;
-        let k = write_copies(weights, scale, out);
+        let (k, s, last) = write_copies(weights, scale, out);
         if k == n {
             return Ok(());
-        }
-        let residual = |i: usize| {
-            let x = weights[i] * scale;
-            x - (x as u64) as f64
-        };
-        let mut s = 0.0f64;
-        let mut last = 0usize;
-        for i in 0..weights.len() {
-            let r = residual(i);
-            if r > 0.0 {
-                last = i;
-            }
-            s += r;
         }
         if s <= 0.0 {
             fill_with_largest(weights, &mut out[k..]);
             return Ok(());
         }
+        let residual = |i: usize| {
+            let x = weights[i] * scale;
+            x - (x as i64) as f64
+        };
         sorted_multinomial(rng, residual, weights.len(), s, last, &mut out[k..]);
         Ok(())
     }
