@@ -2,7 +2,8 @@
 //! resamplers on i.i.d. uniform linear weights, for a shared machine where cri(on)
 //! wall-clock figures include time the thread spent descheduled. Usage:
 //! `cargo run --release -p trajpred-particle --example resample_cpu_time -- N REPS`
-//! (`EXPT=1`: cost of one Exp(1) / one uniform draw with a running sum).
+//! (`EXPT=1`: cost of one Exp(1) / one uniform draw with a running sum; `SCHEME=name`: only
+//! that scheme, e.g. for `perf record`).
 use rand::rngs::SmallRng;
 use rand::{RngExt, SeedableRng};
 use std::hint::black_box;
@@ -25,7 +26,9 @@ fn main() {
         black_box(s);
         let dt = t.elapsed().as_secs_f64() / reps as f64;
         eprintln!("sum {:8.2} ns/p {:8.1} M/s", dt * 1e9 / n as f64, n as f64 / dt / 1e6);
+        let only = std::env::var("SCHEME").ok();
         for scheme in Resampling::ALL {
+            if only.as_deref().is_some_and(|o| o != scheme.name()) { continue; }
             let t = Instant::now(); let c0 = cpu();
             for _ in 0..reps {
                 scheme.resample_into(black_box(&weights), &mut rng, &mut out).unwrap();

@@ -568,23 +568,190 @@ impl Resampler for Residual {
         let c = check_weights(weights)?;
         let n = out.len();
         let scale = n as f64 / c.total;
-        let (k, s, last) = write_copies(weights, scale, out);
-        if k == n {
+        let sums = residual_sums(weights, scale);
+        if sums.copies >= n {
+            // no remainder (or, by rounding, copies for more than n places: clamped)
+            write_copies(weights, scale, out);
             return Ok(());
         }
-        if s <= 0.0 {
+        if sums.residual <= 0.0 {
+            let (k, _, _) = write_copies(weights, scale, out);
             fill_with_largest(weights, &mut out[k..]);
             return Ok(());
         }
-        let residual = |i: usize| {
-            let x = weights[i] * scale;
-            x - (x as i64) as f64
-        };
-        sorted_multinomial(rng, residual, weights.len(), s, last, &mut out[k..]);
+        residual_blocks(weights, scale, sums, rng, out);
         Ok(())
     }
     fn name(&self) -> &'static str {
         "residual"
+    }
+}
+
+/// Particles per block of [`residual_blocks`] (its per-block arrays live on the stack and
+/// stay in the first-level cache).
+const BLOCK: usize = 2048;
+
+/// Slots of the cumulative residuals read per draw of [`residual_blocks`] without a branch.
+const PROBE: usize = 4;
+
+/// Totals of the residual scheme: the copies `sum_i floor(w_i scale)`, the residual sum
+/// (summed per [`BLOCK`] of particles, then over the blocks, as [`residual_blocks`] does),
+/// and the index of the last positive residual.
+#[derive(Debug, Clone, Copy)]
+struct ResidualSums {
+    copies: usize,
+    residual: f64,
+    last: usize,
+}
+
+fn residual_sums(weights: &[f64], scale: f64) -> ResidualSums {
+    let mut copies = 0usize;
+    let mut residual = 0.0f64;
+    let mut last = 0usize;
+    for (b, chunk) in weights.chunks(BLOCK).enumerate() {
+        let mut sb = 0.0f64;
+        let mut lb = usize::MAX;
+        for (s, &w) in chunk.iter().enumerate() {
+            let x = w * scale;
+            let f = x as i64 as usize;
+            let r = x - f as f64;
+            copies = copies.saturating_add(f);
+            sb += r;
+            lb = if r > 0.0 { s } else { lb };
+        }
+        residual += sb;
+        if lb != usize::MAX {
+            last = b * BLOCK + lb;
+        }
+    }
+    ResidualSums {
+        copies,
+        residual,
+        last,
+    }
+}
+
+/// Residual resampling with the remainder drawn block by block, the output written in one
+/// streaming pass, sorted by particle.
+///
+/// Requires `sums.copies < out.len()` and `sums.residual > 0`. With `m = n - copies`
+/// remainder draws from the residuals `r_i`, the multinomial counts are drawn as
+/// 1. per block `b` of [`BLOCK`] particles (residual sum `S_b`), in order: the block's
+///    number of draws `M_b ~ Binomial(m_left, S_b / S_left)` (`m_left`, `S_left`: the draws
+///    and the residual sum of this block and the blocks after it; the block holding the
+///    last positive residual takes all `m_left`), which is the conditional law of a
+///    multinomial's block totals;
+/// 2. within the block, `M_b` i.i.d. draws `u ~ U[0, S_b)` located in the block's cumulative
+///    residuals by a guide table (Chen's index table: `g[t]` = the first particle whose
+///    cumulative residual reaches bucket `t` of `[0, S_b)`, so the particle of `u` is at or
+///    after `g[bucket(u)]`; [`PROBE`] slots from there are compared without a branch, a rare
+///    longer walk falls back to a loop), each draw adding one to the particle's count.
+///
+/// Together that is exactly a multinomial draw of `m` places from `r_i / sum r` (up to
+/// the rounding of `S_b / S_left`, whose relative error is of order `eps S / S_left`).
+/// Then every particle's `floor(n w_i) + count_i` copies are written in index order.
+fn residual_blocks<R: Rng + ?Sized>(
+    weights: &[f64],
+    scale: f64,
+    sums: ResidualSums,
+    rng: &mut R,
+    out: &mut [usize],
+) {
+    let n = out.len();
+    let mut m_left = (n - sums.copies) as u64;
+    let mut s_left = sums.residual;
+    let last_block = sums.last / BLOCK;
+    let mut cum = [0.0f64; BLOCK + PROBE];
+    let mut count = [0usize; BLOCK];
+    let mut guide = [0u16; BLOCK + 1 + RUN];
+    let mut pos = 0usize;
+    for (b, chunk) in weights.chunks(BLOCK).enumerate() {
+        let len = chunk.len();
+        let mut sb = 0.0f64;
+        let mut lb = 0usize;
+        for (s, &w) in chunk.iter().enumerate() {
+            let x = w * scale;
+            let f = x as i64 as usize;
+            let r = x - f as f64;
+            sb += r;
+            lb = if r > 0.0 { s } else { lb };
+            cum[s] = sb;
+            count[s] = f;
+        }
+        cum[len..len + PROBE].fill(f64::INFINITY);
+        let draws = if b >= last_block {
+            m_left
+        } else if m_left == 0 || sb <= 0.0 {
+            0
+        } else {
+            let p = (sb / s_left).min(1.0);
+            match rand_distr::Binomial::new(m_left, p) {
+                Ok(d) => d.sample(rng),
+                Err(_) => 0,
+            }
+        };
+        m_left -= draws;
+        s_left -= sb;
+        if draws > 0 {
+            draw_in_block(&cum[..len + PROBE], sb, lb, draws, rng, &mut count[..len], &mut guide);
+        }
+        let base = b * BLOCK;
+        for (s, &c) in count[..len].iter().enumerate() {
+            let end = pos + c;
+            fill_run(out, pos, end, base + s);
+            pos = end;
+        }
+    }
+    debug_assert_eq!(pos, n);
+}
+
+/// `draws` i.i.d. draws from the residuals of one block (cumulative sums `cum[..len]`, then
+/// [`PROBE`] infinities; total `sb > 0`; last positive residual `lb`), each adding one to
+/// `count` of its particle. `guide` holds at least `len + 1 + RUN` slots.
+#[inline]
+fn draw_in_block<R: Rng + ?Sized>(
+    cum: &[f64],
+    sb: f64,
+    lb: usize,
+    draws: u64,
+    rng: &mut R,
+    count: &mut [usize],
+    guide: &mut [u16],
+) {
+    let len = count.len();
+    let buckets = len;
+    // bucket(x) = floor(x buckets / sb), monotone in x; g[t] = min { s : bucket(cum[s]) >= t }
+    let inv = buckets as f64 / sb;
+    // `as i64` is one instruction (`as usize` is not, below AVX-512); 0 <= x inv <= 2 len
+    let bucket = |x: f64| ((x * inv) as i64 as usize).min(buckets);
+    let g_len = buckets + 1;
+    let lim = g_len + RUN;
+    let mut start = 0usize;
+    for (s, &c) in cum[..len].iter().enumerate() {
+        let k = bucket(c) + 1;
+        if k.wrapping_sub(start) <= RUN {
+            guide[start..start + RUN].fill(s as u16);
+        } else {
+            guide[start..k].fill(s as u16);
+        }
+        start = k.max(start);
+    }
+    debug_assert!(start + RUN <= lim);
+    guide[start.min(g_len)..g_len].fill(lb as u16);
+    let unit = sb * (1.0 / (1u64 << 53) as f64);
+    for _ in 0..draws {
+        let u = (rng.next_u64() >> 11) as f64 * unit;
+        let s0 = guide[bucket(u)] as usize;
+        let mut s = s0;
+        for p in 0..PROBE {
+            s += usize::from(cum[s0 + p] <= u);
+        }
+        if s == s0 + PROBE {
+            while cum[s] <= u {
+                s += 1;
+            }
+        }
+        count[s.min(lb)] += 1;
     }
 }
 
