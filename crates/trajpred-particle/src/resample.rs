@@ -595,8 +595,9 @@ const BLOCK: usize = 2048;
 const PROBE: usize = 4;
 
 /// Totals of the residual scheme: the copies `sum_i floor(w_i scale)`, the residual sum
-/// (summed per [`BLOCK`] of particles, then over the blocks, as [`residual_blocks`] does),
-/// and the index of the last positive residual.
+/// (in four interleaved partial sums: its rounding differs from the blocks' sequential sums
+/// by a relative `O(N eps)`, which only moves the blocks' binomial probabilities by as
+/// much) and the index of the last positive residual.
 #[derive(Debug, Clone, Copy)]
 struct ResidualSums {
     copies: usize,
@@ -604,29 +605,49 @@ struct ResidualSums {
     last: usize,
 }
 
+/// `(floor(x), x - floor(x))` for `x = w scale`, `0 <= x < 2^51`, without a conversion
+/// instruction (Rust's saturating `as` costs a compare and a branch per value): `x - 1/2` is
+/// rounded to an integer by adding [`ROUND`] (exact for `x >= 1/4`, and below that any
+/// rounding stays in `[-1/2, 1/2)`), which is `floor(x)` except for an odd integer `x`
+/// (half to even rounds down), where the fractional part comes out as 1 and is corrected.
+#[inline(always)]
+fn split(w: f64, scale: f64) -> (usize, f64) {
+    let x = w * scale;
+    let y = (x - 0.5) + ROUND;
+    let f = y - ROUND;
+    let i = y.to_bits().wrapping_sub(ROUND.to_bits()) as usize;
+    let r = x - f;
+    let over = r >= 1.0;
+    (
+        i.wrapping_add(usize::from(over)),
+        if over { r - 1.0 } else { r },
+    )
+}
+
 fn residual_sums(weights: &[f64], scale: f64) -> ResidualSums {
-    let mut copies = 0usize;
-    let mut residual = 0.0f64;
-    let mut last = 0usize;
-    for (b, chunk) in weights.chunks(BLOCK).enumerate() {
-        let mut sb = 0.0f64;
-        let mut lb = usize::MAX;
-        for (s, &w) in chunk.iter().enumerate() {
-            let x = w * scale;
-            let f = x as i64 as usize;
-            let r = x - f as f64;
-            copies = copies.saturating_add(f);
-            sb += r;
-            lb = if r > 0.0 { s } else { lb };
-        }
-        residual += sb;
-        if lb != usize::MAX {
-            last = b * BLOCK + lb;
+    let mut k = [0usize; 4];
+    let mut r = [0.0f64; 4];
+    let chunks = weights.chunks_exact(4);
+    let rest = chunks.remainder();
+    for q in chunks {
+        for l in 0..4 {
+            let (f, x) = split(q[l], scale);
+            k[l] += f;
+            r[l] += x;
         }
     }
+    for &w in rest {
+        let (f, x) = split(w, scale);
+        k[0] += f;
+        r[0] += x;
+    }
+    let last = weights
+        .iter()
+        .rposition(|&w| split(w, scale).1 > 0.0)
+        .unwrap_or(0);
     ResidualSums {
-        copies,
-        residual,
+        copies: k[0] + k[1] + k[2] + k[3],
+        residual: (r[0] + r[1]) + (r[2] + r[3]),
         last,
     }
 }
@@ -668,13 +689,9 @@ fn residual_blocks<R: Rng + ?Sized>(
     for (b, chunk) in weights.chunks(BLOCK).enumerate() {
         let len = chunk.len();
         let mut sb = 0.0f64;
-        let mut lb = 0usize;
         for (s, &w) in chunk.iter().enumerate() {
-            let x = w * scale;
-            let f = x as i64 as usize;
-            let r = x - f as f64;
+            let (f, r) = split(w, scale);
             sb += r;
-            lb = if r > 0.0 { s } else { lb };
             cum[s] = sb;
             count[s] = f;
         }
@@ -693,6 +710,9 @@ fn residual_blocks<R: Rng + ?Sized>(
         m_left -= draws;
         s_left -= sb;
         if draws > 0 {
+            // the first particle whose cumulative residual reaches the block's sum: the
+            // last one that can be selected (later ones add nothing)
+            let lb = cum[..len].partition_point(|&c| c < sb);
             draw_in_block(&cum[..len + PROBE], sb, lb, draws, rng, &mut count[..len], &mut guide);
         }
         let base = b * BLOCK;
@@ -706,7 +726,7 @@ fn residual_blocks<R: Rng + ?Sized>(
 }
 
 /// `draws` i.i.d. draws from the residuals of one block (cumulative sums `cum[..len]`, then
-/// [`PROBE`] infinities; total `sb > 0`; last positive residual `lb`), each adding one to
+/// [`PROBE`] infinities; total `sb > 0`; `lb` the first index with `cum[lb] = sb`), each adding one to
 /// `count` of its particle. `guide` holds at least `len + 1 + RUN` slots.
 #[inline]
 fn draw_in_block<R: Rng + ?Sized>(
@@ -720,10 +740,13 @@ fn draw_in_block<R: Rng + ?Sized>(
 ) {
     let len = count.len();
     let buckets = len;
-    // bucket(x) = floor(x buckets / sb), monotone in x; g[t] = min { s : bucket(cum[s]) >= t }
+    // bucket(x) ~ x buckets / sb, monotone in x; g[t] = min { s : bucket(cum[s]) >= t }
     let inv = buckets as f64 / sb;
-    // `as i64` is one instruction (`as usize` is not, below AVX-512); 0 <= x inv <= 2 len
-    let bucket = |x: f64| ((x * inv) as i64 as usize).min(buckets);
+    // x inv rounded to the nearest integer through the bits of x inv + ROUND (no conversion
+    // instruction; any monotone map serves): 0 <= x inv <= len (1 + 2 eps)
+    let bucket = |x: f64| {
+        ((x * inv + ROUND).to_bits().wrapping_sub(ROUND.to_bits()) as usize).min(buckets)
+    };
     let g_len = buckets + 1;
     let lim = g_len + RUN;
     let mut start = 0usize;
@@ -743,8 +766,8 @@ fn draw_in_block<R: Rng + ?Sized>(
         let u = (rng.next_u64() >> 11) as f64 * unit;
         let s0 = guide[bucket(u)] as usize;
         let mut s = s0;
-        for p in 0..PROBE {
-            s += usize::from(cum[s0 + p] <= u);
+        for &c in &cum[s0..s0 + PROBE] {
+            s += usize::from(c <= u);
         }
         if s == s0 + PROBE {
             while cum[s] <= u {
