@@ -181,7 +181,7 @@ const RUN: usize = 4;
 #[inline(always)]
 fn fill_run(out: &mut [usize], start: usize, end: usize, i: usize) {
     if end - start <= RUN && start + RUN <= out.len() {
-        out[start..start + RUN].fill(i);
+        out[start..start + RUN].copy_from_slice(&[i; RUN]);
     } else {
         out[start..end].fill(i);
     }
@@ -684,16 +684,23 @@ fn residual_blocks<R: Rng + ?Sized>(
     let last_block = sums.last / BLOCK;
     let mut cum = [0.0f64; BLOCK + PROBE];
     let mut count = [0usize; BLOCK];
-    let mut guide = [0u16; BLOCK + 1 + RUN];
+    let mut guide = [0u16; 2 * BLOCK + 1 + RUN];
     let mut pos = 0usize;
     for (b, chunk) in weights.chunks(BLOCK).enumerate() {
         let len = chunk.len();
+        // The guide table is built in the same pass, on buckets of the block's expected
+        // residual sum (the average over the blocks left); rebuilt below on the actual sum
+        // if that is off by more than a factor of 2.
+        let expected = s_left * len as f64 / (weights.len() - b * BLOCK) as f64;
+        let mut g = Buckets::new(len, expected);
+        let mut start = 0usize;
         let mut sb = 0.0f64;
         for (s, &w) in chunk.iter().enumerate() {
             let (f, r) = split(w, scale);
             sb += r;
             cum[s] = sb;
             count[s] = f;
+            start = g.extend(&mut guide, start, g.of(sb) + 1, s);
         }
         cum[len..len + PROBE].fill(f64::INFINITY);
         let draws = if b >= last_block {
@@ -710,10 +717,18 @@ fn residual_blocks<R: Rng + ?Sized>(
         m_left -= draws;
         s_left -= sb;
         if draws > 0 {
+            let t = sb * g.inv;
+            if !(t >= 0.5 * len as f64 && t <= 2.0 * len as f64) {
+                g = Buckets::new(len, sb);
+                let mut start = 0usize;
+                for (s, &c) in cum[..len].iter().enumerate() {
+                    start = g.extend(&mut guide, start, g.of(c) + 1, s);
+                }
+            }
             // the first particle whose cumulative residual reaches the block's sum: the
             // last one that can be selected (later ones add nothing)
             let lb = cum[..len].partition_point(|&c| c < sb);
-            draw_in_block(&cum[..len + PROBE], sb, lb, draws, rng, &mut count[..len], &mut guide);
+            draw_in_block(&cum[..len + PROBE], sb, lb, g, draws, rng, &mut count[..len], &guide);
         }
         let base = b * BLOCK;
         for (s, &c) in count[..len].iter().enumerate() {
@@ -725,46 +740,64 @@ fn residual_blocks<R: Rng + ?Sized>(
     debug_assert_eq!(pos, n);
 }
 
+/// The buckets of a guide table over one block: `of(x)`, `x inv` rounded to the nearest
+/// integer (through the bits of `x inv + ROUND`: no conversion instruction) and clamped to
+/// `max = 2 len`; any non-decreasing map of `x` serves. The guide `g[t] = min { s :
+/// of(cum[s]) >= t }` is then a lower bound of the particle of every `u` in bucket `t`
+/// (`cum[s-1] <= u < cum[s]` gives `of(u) <= of(cum[s])`).
+#[derive(Debug, Clone, Copy)]
+struct Buckets {
+    inv: f64,
+    max: usize,
+}
+
+impl Buckets {
+    /// About `len` buckets over `[0, total)`.
+    fn new(len: usize, total: f64) -> Self {
+        let inv = len as f64 / total;
+        Buckets {
+            inv: if inv.is_finite() { inv } else { 0.0 },
+            max: 2 * len,
+        }
+    }
+
+    #[inline(always)]
+    fn of(self, x: f64) -> usize {
+        ((x * self.inv + ROUND).to_bits().wrapping_sub(ROUND.to_bits()) as usize).min(self.max)
+    }
+
+    /// Sets `guide[start..k] = s` (`start <= k <= max + 1`; short runs as a fixed-width
+    /// store whose excess the next call overwrites) and returns `k`.
+    #[inline(always)]
+    fn extend(self, guide: &mut [u16], start: usize, k: usize, s: usize) -> usize {
+        if k - start <= RUN {
+            guide[start..start + RUN].fill(s as u16);
+        } else {
+            guide[start..k].fill(s as u16);
+        }
+        k
+    }
+}
+
 /// `draws` i.i.d. draws from the residuals of one block (cumulative sums `cum[..len]`, then
-/// [`PROBE`] infinities; total `sb > 0`; `lb` the first index with `cum[lb] = sb`), each adding one to
-/// `count` of its particle. `guide` holds at least `len + 1 + RUN` slots.
+/// [`PROBE`] infinities; total `sb > 0`; `lb` the first index with `cum[lb] = sb`), each
+/// adding one to `count` of its particle; `guide` built on `g` over `cum[..len]`.
+#[allow(clippy::too_many_arguments)]
 #[inline]
 fn draw_in_block<R: Rng + ?Sized>(
     cum: &[f64],
     sb: f64,
     lb: usize,
+    g: Buckets,
     draws: u64,
     rng: &mut R,
     count: &mut [usize],
-    guide: &mut [u16],
+    guide: &[u16],
 ) {
-    let len = count.len();
-    let buckets = len;
-    // bucket(x) ~ x buckets / sb, monotone in x; g[t] = min { s : bucket(cum[s]) >= t }
-    let inv = buckets as f64 / sb;
-    // x inv rounded to the nearest integer through the bits of x inv + ROUND (no conversion
-    // instruction; any monotone map serves): 0 <= x inv <= len (1 + 2 eps)
-    let bucket = |x: f64| {
-        ((x * inv + ROUND).to_bits().wrapping_sub(ROUND.to_bits()) as usize).min(buckets)
-    };
-    let g_len = buckets + 1;
-    let lim = g_len + RUN;
-    let mut start = 0usize;
-    for (s, &c) in cum[..len].iter().enumerate() {
-        let k = bucket(c) + 1;
-        if k.wrapping_sub(start) <= RUN {
-            guide[start..start + RUN].fill(s as u16);
-        } else {
-            guide[start..k].fill(s as u16);
-        }
-        start = k.max(start);
-    }
-    debug_assert!(start + RUN <= lim);
-    guide[start.min(g_len)..g_len].fill(lb as u16);
     let unit = sb * (1.0 / (1u64 << 53) as f64);
     for _ in 0..draws {
         let u = (rng.next_u64() >> 11) as f64 * unit;
-        let s0 = guide[bucket(u)] as usize;
+        let s0 = guide[g.of(u)] as usize;
         let mut s = s0;
         for &c in &cum[s0..s0 + PROBE] {
             s += usize::from(c <= u);
