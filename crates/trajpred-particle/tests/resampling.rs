@@ -409,3 +409,151 @@ fn systematic_kernel_equals_the_plain_definition() {
         }
     }
 }
+
+/// Residual resampling's random remainder, drawn per block of particles (binomial block
+/// totals, then draws within each block), over several blocks: counts per particle as
+/// `copies + extra`, accumulated over `reps` seeded runs.
+fn residual_extras(w: &[f64], n: usize, reps: usize, seed: u64) -> (Vec<f64>, Vec<f64>, usize) {
+    let total: f64 = w.iter().sum();
+    let floors: Vec<usize> = w
+        .iter()
+        .map(|&x| (x * (n as f64 / total)).floor() as usize)
+        .collect();
+    let m = n - floors.iter().sum::<usize>();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut out = vec![0usize; n];
+    let mut count = vec![0usize; w.len()];
+    let mut sum = vec![0.0f64; w.len()];
+    let mut sum2 = vec![0.0f64; w.len()];
+    for _ in 0..reps {
+        Residual.resample_into(w, &mut rng, &mut out).expect("residual");
+        count.fill(0);
+        for &i in &out {
+            count[i] += 1;
+        }
+        for i in 0..w.len() {
+            assert!(count[i] >= floors[i], "particle {i} lost a copy");
+            let extra = (count[i] - floors[i]) as f64;
+            sum[i] += extra;
+            sum2[i] += extra * extra;
+        }
+        // the indices come out sorted (copies and remainder merged by particle)
+        assert!(out.windows(2).all(|p| p[0] <= p[1]));
+    }
+    let r = reps as f64;
+    let mean: Vec<f64> = sum.iter().map(|s| s / r).collect();
+    let var: Vec<f64> = sum2
+        .iter()
+        .zip(&mean)
+        .map(|(s2, m)| (s2 / r - m * m) * r / (r - 1.0))
+        .collect();
+    (mean, var, m)
+}
+
+/// The remainder's extra copies are multinomial: with `p_i = r_i / sum r` (residuals
+/// `r_i = n w_i - floor(n w_i)`), `E[extra_i] = m p_i` and `Var[extra_i] = m p_i (1 - p_i)`.
+/// Weights over 3 blocks of particles with zeros, exact-integer `n w_i` (zero residual) and
+/// fractional ones; the scale `n / W` is a power of 2, so `n w_i` is exact.
+/// Means: the statistic `sum_i (mean_i - m p_i)^2 / (m p_i (1 - p_i) / reps)` over the
+/// particles with positive residual is chi-square with as many degrees of freedom `d`
+/// (for these sample sizes nearly so); the check is `|stat - d| < 6 sqrt(2 d)`. Variances:
+/// `sum_i Var[extra_i] = m (1 - sum p_i^2)`, checked within 3%, which a systematic or
+/// stratified remainder (variance at most 1/4 per particle, sum far below `m`) fails.
+#[test]
+fn residual_remainder_is_multinomial() {
+    // per group of 4: weight 0 (never drawn), 1 (n w = 2, no residual), 0.75, 0.25
+    let pattern = [0.0, 1.0, 0.75, 0.25];
+    let len = 5000; // 3 blocks of 2048, the last partial
+    let w: Vec<f64> = (0..len).map(|i| pattern[i % 4]).collect();
+    let total: f64 = w.iter().sum(); // 2500: n / W = 2 for n = 5000
+    let n = 5000;
+    assert_eq!(n as f64 / total, 2.0);
+    let reps = 3000;
+    let (mean, var, m) = residual_extras(&w, n, reps, 11);
+    let scale = n as f64 / total;
+    let r: Vec<f64> = w.iter().map(|&x| x * scale - (x * scale).floor()).collect();
+    let s: f64 = r.iter().sum();
+    assert_eq!(m as f64, s);
+    let mut stat = 0.0;
+    let mut d = 0.0;
+    let mut sum_var = 0.0;
+    let mut sum_p2 = 0.0;
+    for i in 0..len {
+        let p = r[i] / s;
+        if p == 0.0 {
+            assert_eq!((mean[i], var[i]), (0.0, 0.0), "particle {i} without residual drawn");
+            continue;
+        }
+        let e = m as f64 * p;
+        let v = m as f64 * p * (1.0 - p);
+        stat += (mean[i] - e).powi(2) / (v / reps as f64);
+        d += 1.0;
+        sum_var += var[i];
+        sum_p2 += p * p;
+    }
+    assert!(
+        (stat - d).abs() < 6.0 * (2.0 * d).sqrt(),
+        "chi-square {stat} with {d} degrees of freedom"
+    );
+    let expected = m as f64 * (1.0 - sum_p2);
+    assert!(
+        (sum_var / expected - 1.0).abs() < 0.03,
+        "sum of variances {sum_var}, multinomial {expected}"
+    );
+}
+
+/// One positive residual per block: blocks 0 and 2 each hold one particle with residual
+/// 1/2, so the single remainder draw picks either with probability 1/2 (5 standard
+/// errors), and nothing else moves. (A single positive residual in the whole input can
+/// only come from rounding, the residuals summing to the integer `m`.)
+#[test]
+fn residual_remainder_single_residual_per_block() {
+    let mut w = vec![1.0; 5000];
+    w[10] = 1.5;
+    w[4500] = 0.5;
+    let n = 5000; // n / W = 1: copies 1 each, 1 at 10, 0 at 4500, one draw
+    let reps = 4000;
+    let (mean, _, m) = residual_extras(&w, n, reps, 12);
+    assert_eq!(m, 1);
+    let sd = (0.25 / reps as f64).sqrt();
+    assert!((mean[10] - 0.5).abs() < 5.0 * sd, "{}", mean[10]);
+    assert!((mean[4500] - 0.5).abs() < 5.0 * sd, "{}", mean[4500]);
+    assert_eq!(mean[10] + mean[4500], 1.0);
+}
+
+/// No remainder (`n w_i` all integers, over several blocks): the copies only, whatever the
+/// seed; and outputs of a different length than the weights over several blocks keep the
+/// copies and the total.
+#[test]
+fn residual_without_remainder_and_other_output_lengths() {
+    let w = vec![0.5; 4096];
+    let ident: Vec<usize> = (0..4096).collect();
+    for seed in 0..3 {
+        let out = Residual
+            .resample(&w, 4096, &mut ChaCha8Rng::seed_from_u64(seed))
+            .expect("r");
+        assert_eq!(out, ident);
+        let out = Residual
+            .resample(&w, 8192, &mut ChaCha8Rng::seed_from_u64(seed))
+            .expect("r");
+        assert!(out.iter().enumerate().all(|(j, &i)| i == j / 2));
+    }
+    assert_eq!(
+        Residual
+            .resample(&[1.0, 2.0, 1.0], 4, &mut ChaCha8Rng::seed_from_u64(1))
+            .expect("r"),
+        [0, 1, 1, 2]
+    );
+    let w: Vec<f64> = (0..5000).map(|i| ((i * 7919) % 101) as f64).collect();
+    let total: f64 = w.iter().sum();
+    for n in [1usize, 999, 5000, 12_345] {
+        let (mean, _, _) = residual_extras(&w, n, 200, 13);
+        let floors_sum: f64 = w.iter().map(|&x| (x * n as f64 / total).floor()).sum();
+        let extra: f64 = mean.iter().sum();
+        assert!((extra + floors_sum - n as f64).abs() < 1e-9, "n = {n}");
+        assert!(
+            w.iter().zip(&mean).all(|(&x, &e)| x > 0.0 || e == 0.0),
+            "zero weight drawn, n = {n}"
+        );
+    }
+}
