@@ -579,6 +579,13 @@ impl Resampler for Residual {
             fill_with_largest(weights, &mut out[k..]);
             return Ok(());
         }
+        if u32::try_from(n).is_err() {
+            // beyond the block counts' range: copies, then the sorted-uniform remainder
+            let (k, s, last) = write_copies(weights, scale, out);
+            let residual = |i: usize| split(weights[i], scale).1;
+            sorted_multinomial(rng, residual, weights.len(), s, last, &mut out[k..]);
+            return Ok(());
+        }
         residual_blocks(weights, scale, sums, rng, out);
         Ok(())
     }
@@ -655,7 +662,7 @@ fn residual_sums(weights: &[f64], scale: f64) -> ResidualSums {
 /// Residual resampling with the remainder drawn block by block, the output written in one
 /// streaming pass, sorted by particle.
 ///
-/// Requires `sums.copies < out.len()` and `sums.residual > 0`. With `m = n - copies`
+/// Requires `sums.copies < out.len() <= u32::MAX` and `sums.residual > 0`. With `m = n - copies`
 /// remainder draws from the residuals `r_i`, the multinomial counts are drawn as
 /// 1. per block `b` of [`BLOCK`] particles (residual sum `S_b`), in order: the block's
 ///    number of draws `M_b ~ Binomial(m_left, S_b / S_left)` (`m_left`, `S_left`: the draws
@@ -683,7 +690,7 @@ fn residual_blocks<R: Rng + ?Sized>(
     let mut s_left = sums.residual;
     let last_block = sums.last / BLOCK;
     let mut cum = [0.0f64; BLOCK + PROBE];
-    let mut count = [0usize; BLOCK];
+    let mut count = [0u32; BLOCK];
     let mut guide = [0u16; 2 * BLOCK + 1 + RUN];
     let mut pos = 0usize;
     for (b, chunk) in weights.chunks(BLOCK).enumerate() {
@@ -699,7 +706,7 @@ fn residual_blocks<R: Rng + ?Sized>(
             let (f, r) = split(w, scale);
             sb += r;
             cum[s] = sb;
-            count[s] = f;
+            count[s] = f as u32;
             start = g.extend(&mut guide, start, g.of(sb) + 1, s);
         }
         cum[len..len + PROBE].fill(f64::INFINITY);
@@ -732,7 +739,7 @@ fn residual_blocks<R: Rng + ?Sized>(
         }
         let base = b * BLOCK;
         for (s, &c) in count[..len].iter().enumerate() {
-            let end = pos + c;
+            let end = pos + c as usize;
             fill_run(out, pos, end, base + s);
             pos = end;
         }
@@ -791,7 +798,7 @@ fn draw_in_block<R: Rng + ?Sized>(
     g: Buckets,
     draws: u64,
     rng: &mut R,
-    count: &mut [usize],
+    count: &mut [u32],
     guide: &[u16],
 ) {
     let unit = sb * (1.0 / (1u64 << 53) as f64);
