@@ -22,10 +22,15 @@
 //! from `w_i - floor(n w_i)` instead of `n w_i - floor(n w_i)`, which is biased (filterpy
 //! issue #290).
 //!
-//! The random variants ([`Resampler::resample_into`]) run in `O(n + N)` without allocating:
-//! the multinomial and residual remainders draw *sorted* uniforms as normalised cumulative
-//! sums of exponential variates (the order statistics of uniforms), so the selection is one
-//! merge pass instead of a binary search per draw; the resulting indices come out sorted.
+//! The random variants ([`Resampler::resample_into`]) run in `O(n + N)` without allocating
+//! (their scratch is a few fixed-size arrays on the stack) and return sorted indices. The
+//! multinomial scheme draws *sorted* uniforms as normalised cumulative sums of exponential
+//! variates (the order statistics of uniforms), so the selection is one merge pass instead
+//! of a binary search per draw. The residual scheme draws its remainder per block of
+//! particles: the block's number of draws is binomial given the draws left (the conditional
+//! law of a multinomial's block totals), and each draw is located in the block's cumulative
+//! residuals through a guide table (expected `O(1)` per draw); the copies and the drawn
+//! places are then written per particle in one streaming pass.
 //! The deterministic variants ([`systematic_indices`], [`stratified_indices`],
 //! [`multinomial_indices`], [`residual_indices`]) take the uniforms as input and follow the
 //! order of the given uniforms (the reference definitions used by the tests).
@@ -555,6 +560,9 @@ impl Resampler for Multinomial {
 /// Residual resampling (the MKPF paper's scheme): `floor(n w_i)` copies of each particle,
 /// then the remaining `n - sum floor(n w_i)` places drawn multinomially from the residual
 /// weights `n w_i - floor(n w_i)`.
+///
+/// The remainder is an exact multinomial draw (see the module documentation for how it is
+/// drawn); the indices come out sorted, each particle's copies and drawn places together.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Residual;
 
@@ -735,7 +743,16 @@ fn residual_blocks<R: Rng + ?Sized>(
             // the first particle whose cumulative residual reaches the block's sum: the
             // last one that can be selected (later ones add nothing)
             let lb = cum[..len].partition_point(|&c| c < sb);
-            draw_in_block(&cum[..len + PROBE], sb, lb, g, draws, rng, &mut count[..len], &guide);
+            draw_in_block(
+                &cum[..len + PROBE],
+                sb,
+                lb,
+                g,
+                draws,
+                rng,
+                &mut count[..len],
+                &guide,
+            );
         }
         let base = b * BLOCK;
         for (s, &c) in count[..len].iter().enumerate() {
@@ -770,7 +787,10 @@ impl Buckets {
 
     #[inline(always)]
     fn of(self, x: f64) -> usize {
-        ((x * self.inv + ROUND).to_bits().wrapping_sub(ROUND.to_bits()) as usize).min(self.max)
+        ((x * self.inv + ROUND)
+            .to_bits()
+            .wrapping_sub(ROUND.to_bits()) as usize)
+            .min(self.max)
     }
 
     /// Sets `guide[start..k] = s` (`start <= k <= max + 1`; short runs as a fixed-width

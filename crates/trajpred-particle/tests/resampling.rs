@@ -426,7 +426,9 @@ fn residual_extras(w: &[f64], n: usize, reps: usize, seed: u64) -> (Vec<f64>, Ve
     let mut sum = vec![0.0f64; w.len()];
     let mut sum2 = vec![0.0f64; w.len()];
     for _ in 0..reps {
-        Residual.resample_into(w, &mut rng, &mut out).expect("residual");
+        Residual
+            .resample_into(w, &mut rng, &mut out)
+            .expect("residual");
         count.fill(0);
         for &i in &out {
             count[i] += 1;
@@ -481,7 +483,11 @@ fn residual_remainder_is_multinomial() {
     for i in 0..len {
         let p = r[i] / s;
         if p == 0.0 {
-            assert_eq!((mean[i], var[i]), (0.0, 0.0), "particle {i} without residual drawn");
+            assert_eq!(
+                (mean[i], var[i]),
+                (0.0, 0.0),
+                "particle {i} without residual drawn"
+            );
             continue;
         }
         let e = m as f64 * p;
