@@ -163,8 +163,7 @@ where
     T: RealField + Copy,
     D: Dim,
     M: Dim,
-    DefaultAllocator:
-        Allocator<D, D> + Allocator<D, M> + Allocator<M, D> + Allocator<M, M>,
+    DefaultAllocator: Allocator<D, D> + Allocator<D, M> + Allocator<M, D> + Allocator<M, M>,
 {
     if is_static::<D, M>() && M::try_to_usize() != Some(0) {
         let (d, m) = k.shape_generic();
@@ -490,18 +489,28 @@ where
     ok
 }
 
-/// The fast part of [`check_state`] for the factorising predict: finite mean and `P`, `P`
-/// symmetric to [`symmetry_tolerance`] (definiteness is left to the factorisation).
+/// The fast check of a state for the factorising predict, **to be combined with a
+/// successful `L D L^T` factorisation of `P`** (which reads the lower triangle and fails on a
+/// non-finite or non-positive pivot, so it already proves the lower triangle finite and
+/// positive definite): a finite mean, and `P` symmetric to [`symmetry_tolerance`] of the
+/// largest diagonal element (for a positive definite matrix the largest magnitude is on the
+/// diagonal). A non-finite upper element fails the symmetry test (the tolerance is finite
+/// whenever the factorisation succeeded), so no separate finiteness pass over `P` is needed.
 #[inline(always)]
-pub(crate) fn state_finite_and_symmetric<T, D>(state: &Gaussian<T, D>) -> bool
+pub(crate) fn mean_finite_and_symmetric<T, D>(state: &Gaussian<T, D>) -> bool
 where
     T: RealField + Copy,
     D: Dim,
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     let p = &state.covariance;
-    let tol = symmetry_tolerance(amax_finite(p));
-    let mut ok = all_finite(&state.mean) & all_finite(p);
+    let mut scale = T::zero();
+    for j in 0..p.nrows() {
+        let v = p[(j, j)];
+        scale = if v > scale { v } else { scale };
+    }
+    let tol = symmetry_tolerance(scale);
+    let mut ok = all_finite(&state.mean);
     for j in 0..p.nrows() {
         for i in 0..j {
             ok &= (p[(i, j)] - p[(j, i)]).abs() <= tol;
