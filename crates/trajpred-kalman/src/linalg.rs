@@ -308,14 +308,15 @@ where
     #[inline(always)]
     pub(crate) fn new(mut a: OMatrix<T, D, D>) -> Option<Self> {
         let n = a.nrows();
+        // one verdict without branches, as in `positive_definite_shifted`
+        let big = T::max_value().unwrap_or(T::one() / T::zero());
+        let mut ok = true;
         for j in 0..n {
             let mut d = a[(j, j)];
             for k in 0..j {
                 d -= a[(j, k)] * a[(j, k)];
             }
-            if d <= T::zero() || !d.is_finite() {
-                return None;
-            }
+            ok &= (d > T::zero()) & (d <= big);
             let ljj = d.sqrt();
             a[(j, j)] = ljj;
             for i in (j + 1)..n {
@@ -329,7 +330,7 @@ where
                 a[(i, j)] = T::zero();
             }
         }
-        Some(Chol { l: a })
+        ok.then_some(Chol { l: a })
     }
 
     /// The factor `L`, by value.
@@ -565,6 +566,10 @@ where
     DefaultAllocator: Allocator<D, D>,
 {
     let n = a.nrows();
+    // `0 < d <= max` is false for a NaN or infinite pivot too: one verdict accumulated
+    // without branches (after a bad pivot the remaining arithmetic is harmless)
+    let big = T::max_value().unwrap_or(T::one() / T::zero());
+    let mut ok = true;
     for j in 0..n {
         // row j of L is in a[(j, k)], k < j; w_k = L_jk d_k goes to the unused a[(k, j)]
         let mut d = a[(j, j)] + shift;
@@ -573,9 +578,7 @@ where
             a[(k, j)] = w;
             d -= a[(j, k)] * w;
         }
-        if d <= T::zero() || !d.is_finite() {
-            return false;
-        }
+        ok &= (d > T::zero()) & (d <= big);
         a[(j, j)] = d;
         let inv = T::one() / d;
         for i in (j + 1)..n {
@@ -586,7 +589,7 @@ where
             a[(i, j)] = s * inv;
         }
     }
-    true
+    ok
 }
 
 /// Checks that `m` is symmetric positive definite (its Cholesky factor exists).
