@@ -22,6 +22,70 @@ use crate::linalg::{
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
 
+/// A function `g` evaluated at the `2n + 1` symmetric sigma points `x`, `x + L_j`,
+/// `x - L_j` (`L_j` the columns of a lower-triangular `L`): `g(x)`, and the matrices whose
+/// column `j` is `g(x + L_j)`, respectively `g(x - L_j)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SigmaImages<T: RealField, D: Dim, E: Dim>
+where
+    DefaultAllocator: Allocator<E> + Allocator<E, D>,
+{
+    /// `g(x)`.
+    pub center: OVector<T, E>,
+    /// Column `j`: `g(x + L_j)`.
+    pub plus: OMatrix<T, E, D>,
+    /// Column `j`: `g(x - L_j)`.
+    pub minus: OMatrix<T, E, D>,
+}
+
+/// The per-point evaluation of [`SigmaImages`]: `g` once per sigma point, with one point
+/// buffer (`L` lower triangular: `x +- L_j` differ from `x` only in rows `j..n`).
+#[inline(always)]
+pub(crate) fn sigma_images_per_point<T, D, E, G>(
+    x: &OVector<T, D>,
+    l: &OMatrix<T, D, D>,
+    g: G,
+) -> Result<SigmaImages<T, D, E>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    E: Dim,
+    G: Fn(&OVector<T, D>) -> Result<OVector<T, E>>,
+    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<E> + Allocator<E, D>,
+{
+    let n = x.nrows();
+    check_dim("sigma-point spread", n, l.nrows())?;
+    check_dim("sigma-point spread", n, l.ncols())?;
+    let center = g(x)?;
+    let e = center.shape_generic().0;
+    let d = x.shape_generic().0;
+    let mut plus = OMatrix::<T, E, D>::zeros_generic(e, d);
+    let mut minus = OMatrix::<T, E, D>::zeros_generic(e, d);
+    let mut pt = x.clone();
+    for j in 0..n {
+        for i in j..n {
+            pt[i] = x[i] + l[(i, j)];
+        }
+        let yp = g(&pt)?;
+        check_dim("transformed sigma point", e.value(), yp.nrows())?;
+        plus.set_column(j, &yp);
+        for i in j..n {
+            pt[i] = x[i] - l[(i, j)];
+        }
+        let ym = g(&pt)?;
+        check_dim("transformed sigma point", e.value(), ym.nrows())?;
+        minus.set_column(j, &ym);
+        for i in j..n {
+            pt[i] = x[i];
+        }
+    }
+    Ok(SigmaImages {
+        center,
+        plus,
+        minus,
+    })
+}
+
 /// A state transition `x(k+1) = f(x(k)) + w`, `w ~ N(0, Q)`.
 pub trait Transition<T: RealField + Copy, D: Dim>
 where
@@ -43,6 +107,19 @@ where
     /// and every spread with this function, so wrapping here gives correct angular means.
     fn state_residual(&self, a: &OVector<T, D>, b: &OVector<T, D>) -> OVector<T, D> {
         a - b
+    }
+
+    /// `f` at the sigma points `x`, `x +- L_j` of a lower-triangular `L` (the UKF's
+    /// predict). By default one [`Transition::transition`] call per point; a model may
+    /// override it to share work between points (the coordinated turn shares `sin`/`cos`
+    /// of the turn angle by the angle-addition formulas). The result must equal the
+    /// per-point one up to rounding.
+    fn transition_sigma_points(
+        &self,
+        x: &OVector<T, D>,
+        l: &OMatrix<T, D, D>,
+    ) -> Result<SigmaImages<T, D, D>> {
+        sigma_images_per_point(x, l, |p| self.transition(p))
     }
 }
 
@@ -116,6 +193,21 @@ where
     fn normalize_observation(&self, z: OVector<T, M>) -> OVector<T, M> {
         z
     }
+
+    /// `h` at the sigma points `x`, `x +- L_j` of a lower-triangular `L` (the UKF's update).
+    /// By default one [`Observation::observe`] call per point; a model may override it to
+    /// share work between points (range-bearing reuses `h(x)` for the points that do not
+    /// move the position). The result must equal the per-point one up to rounding.
+    fn observe_sigma_points(
+        &self,
+        x: &OVector<T, D>,
+        l: &OMatrix<T, D, D>,
+    ) -> Result<SigmaImages<T, D, M>>
+    where
+        DefaultAllocator: Allocator<M, D>,
+    {
+        sigma_images_per_point(x, l, |p| self.observe(p))
+    }
 }
 
 /// An [`Observation`] with its Jacobian `H(x) = dh/dx` (an `m x n` matrix), needed by the EKF.
@@ -164,6 +256,13 @@ where
     }
     fn state_residual(&self, a: &OVector<T, D>, b: &OVector<T, D>) -> OVector<T, D> {
         (**self).state_residual(a, b)
+    }
+    fn transition_sigma_points(
+        &self,
+        x: &OVector<T, D>,
+        l: &OMatrix<T, D, D>,
+    ) -> Result<SigmaImages<T, D, D>> {
+        (**self).transition_sigma_points(x, l)
     }
 }
 
@@ -217,6 +316,16 @@ where
     }
     fn normalize_observation(&self, z: OVector<T, M>) -> OVector<T, M> {
         (**self).normalize_observation(z)
+    }
+    fn observe_sigma_points(
+        &self,
+        x: &OVector<T, D>,
+        l: &OMatrix<T, D, D>,
+    ) -> Result<SigmaImages<T, D, M>>
+    where
+        DefaultAllocator: Allocator<M, D>,
+    {
+        (**self).observe_sigma_points(x, l)
     }
 }
 
