@@ -70,7 +70,10 @@ impl ObservationModel<f64, U4, U2> for AdsObservation {
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let which = args.get(1).map(String::as_str).unwrap_or("kf");
-    let steps: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1_000_000);
+    let steps: usize = args
+        .get(2)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1_000_000);
 
     let dt = 0.1;
     let tr: LinearTransition<f64, U4> =
@@ -119,7 +122,9 @@ fn main() {
     for _ in 0..steps {
         match which {
             "kf" => {
-                let s = kf.step(black_box(&state), Some(black_box(&z))).expect("step");
+                let s = kf
+                    .step(black_box(&state), Some(black_box(&z)))
+                    .expect("step");
                 black_box(s.update.map(|u| u.posterior));
             }
             "kf_cheap" => {

@@ -497,9 +497,10 @@ where
         symmetrise(&mut cov);
     }
     let log_likelihood = gaussian_log_likelihood(&chol, &y);
-    check_finite(&mean, "posterior mean")?;
-    check_finite(&cov, "posterior covariance")?;
-    if !log_likelihood.is_finite() {
+    // one branch for the three output checks; the error is located only on failure
+    if !(all_finite(&mean) & all_finite(&cov) & log_likelihood.is_finite()) {
+        check_finite(&mean, "posterior mean")?;
+        check_finite(&cov, "posterior covariance")?;
         return Err(KalmanError::NonFinite {
             what: "log-likelihood",
             index: 0,

@@ -9,8 +9,8 @@
 use crate::error::{KalmanError, Result};
 use crate::linalg::{check_dim, check_pd, check_psd};
 use crate::model::{
-    LinearObservation, LinearTransition, Observation, ObservationJacobian, SigmaImages,
-    Transition, TransitionJacobian,
+    LinearObservation, LinearTransition, Observation, ObservationJacobian, SigmaImages, Transition,
+    TransitionJacobian,
 };
 use nalgebra::allocator::Allocator;
 use nalgebra::{
