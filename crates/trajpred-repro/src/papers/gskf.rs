@@ -700,9 +700,9 @@ pub fn run(ctx: &Context) -> Result<PaperResult> {
     for (i, name) in METHODS.iter().enumerate() {
         let s = &scores[i];
         let mut row: Vec<Value> = vec![(*name).into()];
-        for a in 0..3 {
-            row.push(s.axes[a].into());
-            row.push(PAPER_TABLE3[i][a].into());
+        for (ours, paper) in s.axes.iter().zip(&PAPER_TABLE3[i]) {
+            row.push((*ours).into());
+            row.push((*paper).into());
         }
         row.push(s.rmse_3d.into());
         row.push(PAPER_TABLE3[i][3].into());
