@@ -90,8 +90,10 @@ const MIN_POINTS_SHORTEST: usize = 10 + HORIZON;
 /// How much of the data a run uses.
 #[derive(Debug, Clone, Copy)]
 struct Budget {
-    /// Read at most this many user folders (GeoLife) or taxi files (T-Drive).
-    max_files: Option<usize>,
+    /// Read at most this many GeoLife user folders.
+    max_users: Option<usize>,
+    /// Read at most this many T-Drive taxi files.
+    max_taxis: Option<usize>,
     /// At most this many test trajectories.
     max_test: usize,
     /// At most this many training trajectories (HMM).
@@ -108,7 +110,8 @@ impl Budget {
     fn new(quick: bool) -> Self {
         if quick {
             Budget {
-                max_files: Some(6),
+                max_users: Some(6),
+                max_taxis: Some(40),
                 max_test: 24,
                 max_train: 24,
                 origins: 4,
@@ -117,8 +120,9 @@ impl Budget {
             }
         } else {
             Budget {
-                max_files: None,
-                max_test: 600,
+                max_users: None,
+                max_taxis: None,
+                max_test: 800,
                 max_train: 400,
                 origins: 8,
                 stride: 10,
@@ -282,7 +286,11 @@ fn load(ds: Ds, dir: &Path, budget: &Budget) -> Result<Loaded> {
         }
     };
     let units_total = units.len();
-    let take = budget.max_files.unwrap_or(usize::MAX).min(units_total);
+    let cap = match ds {
+        Ds::Geolife => budget.max_users,
+        Ds::Tdrive => budget.max_taxis,
+    };
+    let take = cap.unwrap_or(usize::MAX).min(units_total);
     let mut report = LoadReport::new();
     let mut tracks = Vec::new();
     for unit in &units[..take] {
@@ -1042,7 +1050,10 @@ pub fn run(ctx: &Context) -> Result<PaperResult> {
         let data = load(ds, &dir, &budget)?;
         let load_s = t0.elapsed().as_secs_f64();
         out.data.extend(data_lines(ds, &data));
-        log::info!("kf-dynamic: loaded {} in {load_s:.1} s", ds.label());
+        out.data.push(format!(
+            "{}: reading and splitting took {load_s:.1} s of wall time.",
+            ds.label()
+        ));
         let grid = run_grid(ds, &data, ctx, &budget)?;
         tables_and_figures(ds, &grid, &budget, &mut out)?;
         claims(ds, &grid, &mut out);
@@ -1110,8 +1121,9 @@ fn notes(ctx: &Context, budget: &Budget, out: &mut PaperResult) {
          at most {} origins per test trajectory {} points apart.",
         if ctx.quick {
             format!(
-                "quick run: at most {} user folders / taxi files read, ",
-                budget.max_files.unwrap_or(0)
+                "quick run: at most {} GeoLife user folders and {} T-Drive taxi files read, ",
+                budget.max_users.unwrap_or(0),
+                budget.max_taxis.unwrap_or(0)
             )
         } else {
             String::new()
