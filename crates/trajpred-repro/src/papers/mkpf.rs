@@ -12,8 +12,9 @@ pub mod experiment;
 use crate::report::{Figure, PaperResult, Table, Value};
 use crate::{Context, Result};
 use experiment::{
-    ACCEL_GRID, ADSB_FILE, Flight, INITIAL_SPEED_SD, INITIAL_TURN_RATE_SD, MAX_GAP_S, Method,
-    Motion, Noise, Run, Setup, TURN_GRID, choose_noise, load_flight, run_method, synthetic_flight,
+    ACCEL_GRID, ADSB_FILE, Flight, INITIAL_SPEED_SD, MAX_GAP_S, MAX_Q_CONDITION, Method, Motion,
+    Noise, Run, Setup, TURN_GRID, TURN_RATE_SD_GRID, choose_noise, load_flight, run_method,
+    synthetic_flight,
 };
 use trajpred::plot::{Chart, Series};
 
@@ -56,9 +57,10 @@ fn settings(ctx: &Context) -> Settings {
     }
 }
 
-fn methods() -> [Method; 5] {
+fn methods() -> [Method; 6] {
     [
         Method::Mkpf(PARTICLES),
+        Method::MkpfConditioned(PARTICLES),
         Method::Bootstrap(PARTICLES),
         Method::Bootstrap(PARTICLES * BOOTSTRAP_FACTOR),
         Method::Ukf,
@@ -235,6 +237,7 @@ fn noise_table(id: &str, title: &str, res: &FlightResult) -> Result<Table> {
         .label("model")
         .ours("acceleration noise (m^2/s^3)", 3, 0.0, 1e-12)
         .ours("turn-rate noise (rad^2/s^3)", 9, 0.0, 1e-12)
+        .ours("initial turn-rate sd (rad/s)", 3, 0.0, 1e-12)
         .ours("log-likelihood of the kept frames", 2, 1e-9, 1e-9);
     for (m, q) in &res.noise {
         t.push(vec![
@@ -244,13 +247,19 @@ fn noise_table(id: &str, title: &str, res: &FlightResult) -> Result<Table> {
                 Motion::Cv => Value::Missing,
                 Motion::Ct => q.turn.into(),
             },
+            match m {
+                Motion::Cv => Value::Missing,
+                Motion::Ct => q.turn_rate_sd.into(),
+            },
             q.log_likelihood.into(),
         ])?;
     }
     t.note(format!(
         "Chosen by the UKF log-likelihood of the kept frames only (never the compared frames), \
          over the grid {ACCEL_GRID:?} (continuous white-noise acceleration, per axis) and, for \
-         the coordinated turn, {TURN_GRID:?} (turn-rate random walk). Observation noise fixed \
+         the coordinated turn, {TURN_GRID:?} (turn-rate random walk) with the initial turn-rate sd \
+         in {TURN_RATE_SD_GRID:?}; coordinated-turn noises whose Q has a condition number over \
+         {MAX_Q_CONDITION:e} are skipped. Observation noise fixed \
          at sd {} m per axis.",
         experiment::POSITION_SD_M
     ));
@@ -502,15 +511,16 @@ fn notes(s: &Settings, setup: &Setup) -> Vec<String> {
             "Noise: observation sd {} m per axis (a stated ADS-B accuracy, not fitted); process \
              noise chosen per model by the UKF likelihood of the kept frames only (Tables 1b, \
              2b), shared by all four filters. Initial state: the first kept position, zero \
-             velocity with sd {INITIAL_SPEED_SD} m/s per axis, turn rate 0 with sd \
-             {INITIAL_TURN_RATE_SD} rad/s.",
+             velocity with sd {INITIAL_SPEED_SD} m/s per axis, turn rate 0 with the sd chosen \
+             with the process noise.",
             setup.position_sd
         ),
         format!(
             "Particle filters: the MKPF and the bootstrap PF with {PARTICLES} particles each, \
              and a bootstrap PF with {} particles; residual resampling at every step (the \
              paper); MKPF with the crate's defaults (carried particle covariances, augmented \
-             UKF, relinearised EKF stage, Merwe sigma points alpha 1e-3, beta 2, kappa 0). The \
+             UKF, relinearised EKF stage, Merwe sigma points alpha 1e-3, beta 2, kappa 0), and \
+             once more with the conditioned particle prior (docs/particle.md). The \
              step between kept frames varies with the report times, so the filters are rebuilt \
              for each new step with the same particles; the MKPF's particles then all carry the \
              mean of their covariances (exact for the linear CV model, an approximation for the \

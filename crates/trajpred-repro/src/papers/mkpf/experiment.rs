@@ -20,7 +20,7 @@ use trajpred_kalman::{
     CoordinatedTurn, Ekf, Filter, LinearObservation, LinearTransition, MerweSigmaPoints,
     NoisyTransition, Transition, TransitionJacobian, Ukf,
 };
-use trajpred_particle::{Mkpf, ParticleCloud, ParticleFilter, ParticleFiltering};
+use trajpred_particle::{Mkpf, ParticleCloud, ParticleFilter, ParticleFiltering, ParticlePrior};
 
 /// ADS-B horizontal position noise, standard deviation per axis in metres (`R = sd^2 I`): a
 /// stated physical value (NACp 8 bounds the 95% horizontal error by 30 m), not fitted.
@@ -28,13 +28,20 @@ pub const POSITION_SD_M: f64 = 15.0;
 /// Standard deviation of each velocity component in the initial state (m/s): vague, of the
 /// order of an airliner's speed (the filters start from one position and no velocity).
 pub const INITIAL_SPEED_SD: f64 = 150.0;
-/// Standard deviation of the turn rate in the initial state (rad/s), about a standard-rate
-/// turn (3 degrees per second).
-pub const INITIAL_TURN_RATE_SD: f64 = 0.05;
+/// Candidate standard deviations of the turn rate in the initial state (rad/s), chosen with
+/// the process noise by the likelihood of the kept frames: from a quarter of a degree per
+/// second to about a standard-rate turn (3 degrees per second). Wide priors put weight on
+/// turn rates that alias over the time between kept frames.
+pub const TURN_RATE_SD_GRID: [f64; 4] = [0.005, 0.01, 0.02, 0.05];
 /// Candidate white-noise acceleration spectral densities (m^2/s^3) searched by likelihood.
-pub const ACCEL_GRID: [f64; 9] = [1e-3, 3e-3, 1e-2, 3e-2, 1e-1, 3e-1, 1.0, 3.0, 10.0];
+pub const ACCEL_GRID: [f64; 11] = [
+    1e-3, 3e-3, 1e-2, 3e-2, 1e-1, 3e-1, 1.0, 3.0, 10.0, 30.0, 100.0,
+];
 /// Candidate turn-rate noise spectral densities (rad^2/s^3) for the coordinated turn.
 pub const TURN_GRID: [f64; 5] = [1e-9, 1e-8, 1e-7, 1e-6, 1e-5];
+/// Largest ratio of the position variance to the turn-rate variance of a coordinated-turn
+/// `Q` searched (beyond it the MKPF's Cholesky test of `Q` fails).
+pub const MAX_Q_CONDITION: f64 = 1e10;
 /// A real flight is split where two successive fresh position reports are further apart.
 pub const MAX_GAP_S: f64 = 10.0;
 /// Where the synthetic flight is placed on the Earth (latitude, longitude in degrees): near
@@ -82,6 +89,10 @@ pub enum Method {
     /// The MKPF (per particle a UKF step then an EKF step give the proposal; eq. 9 weights;
     /// residual resampling every step), with this many particles.
     Mkpf(usize),
+    /// The MKPF with the crate's `ParticlePrior::Conditioned` (each particle's UKF step
+    /// starts from its own transition `N(f(x), Q)`, approximating the optimal proposal)
+    /// instead of the carried covariance of the paper's Algorithm 1.
+    MkpfConditioned(usize),
     /// The bootstrap particle filter (transition prior as proposal; residual resampling every
     /// step), with this many particles.
     Bootstrap(usize),
@@ -96,6 +107,7 @@ impl Method {
     pub fn name(self) -> String {
         match self {
             Method::Mkpf(_) => "MKPF".into(),
+            Method::MkpfConditioned(_) => "MKPF (conditioned prior)".into(),
             Method::Bootstrap(_) => "bootstrap PF".into(),
             Method::Ukf => "UKF".into(),
             Method::Ekf => "EKF".into(),
@@ -105,7 +117,7 @@ impl Method {
     /// The particle count, if a particle filter.
     pub fn particles(self) -> Option<usize> {
         match self {
-            Method::Mkpf(n) | Method::Bootstrap(n) => Some(n),
+            Method::Mkpf(n) | Method::MkpfConditioned(n) | Method::Bootstrap(n) => Some(n),
             Method::Ukf | Method::Ekf => None,
         }
     }
@@ -119,6 +131,8 @@ pub struct Noise {
     pub accel: f64,
     /// Turn-rate spectral density, rad^2/s^3 (unused by CV).
     pub turn: f64,
+    /// Initial turn-rate standard deviation, rad/s (unused by CV).
+    pub turn_rate_sd: f64,
     /// UKF log-likelihood of the kept frames under this noise.
     pub log_likelihood: f64,
 }
@@ -280,7 +294,7 @@ where
     )?)
 }
 
-fn initial<D: DimName>(z: [f64; 2], sd: f64) -> Gaussian<f64, D>
+fn initial<D: DimName>(z: [f64; 2], setup: &Setup, noise: &Noise) -> Gaussian<f64, D>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
@@ -288,12 +302,13 @@ where
     mean[0] = z[0];
     mean[2] = z[1];
     let mut cov = OMatrix::<f64, D, D>::zeros();
+    let sd = setup.position_sd;
     let v = INITIAL_SPEED_SD * INITIAL_SPEED_SD;
     for (i, var) in [sd * sd, v, sd * sd, v].into_iter().enumerate() {
         cov[(i, i)] = var;
     }
     if D::dim() > 4 {
-        cov[(4, 4)] = INITIAL_TURN_RATE_SD * INITIAL_TURN_RATE_SD;
+        cov[(4, 4)] = noise.turn_rate_sd * noise.turn_rate_sd;
     }
     Gaussian {
         mean,
@@ -425,6 +440,7 @@ where
     filter: Option<(f64, Mkpf<f64, D, U2, Tr, LinearObservation<f64, D, U2>>)>,
     initial: Gaussian<f64, D>,
     particles: usize,
+    prior: ParticlePrior,
     rng: ChaCha8Rng,
 }
 
@@ -447,7 +463,8 @@ where
                 self.particles,
                 points,
                 &mut self.rng,
-            )?,
+            )?
+            .with_particle_prior(self.prior),
             Some((old_dt, f)) if old_dt == dt => f,
             Some((_, f)) => {
                 // a new time step needs a new transition (and Q): rebuild, every particle
@@ -464,6 +481,7 @@ where
                     mean_cov,
                     points,
                 )?
+                .with_particle_prior(self.prior)
             }
         };
         ParticleFiltering::<f64, D, U2>::step(
@@ -571,6 +589,7 @@ fn run_generic<D, Tr>(
     prep: &Prepared,
     flight: &Flight,
     setup: &Setup,
+    noise: &Noise,
     make: MakeModel<'_, Tr>,
     method: Method,
     seed: u64,
@@ -584,7 +603,7 @@ where
     OMatrix<f64, U2, D>: Send + Sync,
 {
     let obs = observation::<D>(setup.position_sd)?;
-    let initial = initial::<D>(prep.observed[0], setup.position_sd);
+    let initial = initial::<D>(prep.observed[0], setup, noise);
     let rng = ChaCha8Rng::seed_from_u64(seed);
     let mut stepper: Box<dyn Stepper<D> + '_> = match method {
         Method::Ukf | Method::Ekf => Box::new(KalmanStepper {
@@ -593,12 +612,16 @@ where
             state: initial,
             unscented: method == Method::Ukf,
         }),
-        Method::Mkpf(particles) => Box::new(MkpfStepper {
+        Method::Mkpf(particles) | Method::MkpfConditioned(particles) => Box::new(MkpfStepper {
             make,
             obs,
             filter: None,
             initial,
             particles,
+            prior: match method {
+                Method::MkpfConditioned(_) => ParticlePrior::Conditioned,
+                _ => ParticlePrior::Carried,
+            },
             rng,
         }),
         Method::Bootstrap(particles) => Box::new(BootstrapStepper {
@@ -628,11 +651,11 @@ pub fn run_method(
     let (frames, predicted_enu) = match motion {
         Motion::Cv => {
             let make = |dt: f64| cv_model(noise, dt);
-            run_generic::<U4, _>(&prep, flight, setup, &make, method, seed)?
+            run_generic::<U4, _>(&prep, flight, setup, noise, &make, method, seed)?
         }
         Motion::Ct => {
             let make = |dt: f64| ct_model(noise, dt);
-            run_generic::<U5, _>(&prep, flight, setup, &make, method, seed)?
+            run_generic::<U5, _>(&prep, flight, setup, noise, &make, method, seed)?
         }
     };
     let seconds = start.elapsed().as_secs_f64();
@@ -661,7 +684,8 @@ fn kept_log_likelihood(
     fn ll<D, Tr>(
         prep: &Prepared,
         times: &[f64],
-        sd: f64,
+        setup: &Setup,
+        noise: &Noise,
         make: &dyn Fn(f64) -> Result<Tr>,
     ) -> Result<f64>
     where
@@ -669,8 +693,8 @@ fn kept_log_likelihood(
         Tr: Transition<f64, D>,
         DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<U2, D> + Allocator<D, U2>,
     {
-        let obs = observation::<D>(sd)?;
-        let mut state = initial::<D>(prep.observed[0], sd);
+        let obs = observation::<D>(setup.position_sd)?;
+        let mut state = initial::<D>(prep.observed[0], setup, noise);
         let mut total = 0.0;
         for w in prep.kept.windows(2) {
             let tr = make(times[w[1]] - times[w[0]])?;
@@ -684,12 +708,8 @@ fn kept_log_likelihood(
         Ok(total)
     }
     match motion {
-        Motion::Cv => ll::<U4, _>(prep, &flight.times, setup.position_sd, &|dt| {
-            cv_model(noise, dt)
-        }),
-        Motion::Ct => ll::<U5, _>(prep, &flight.times, setup.position_sd, &|dt| {
-            ct_model(noise, dt)
-        }),
+        Motion::Cv => ll::<U4, _>(prep, &flight.times, setup, noise, &|dt| cv_model(noise, dt)),
+        Motion::Ct => ll::<U5, _>(prep, &flight.times, setup, noise, &|dt| ct_model(noise, dt)),
     }
 }
 
@@ -698,18 +718,33 @@ fn kept_log_likelihood(
 /// the compared in-between frames are never used to choose it. Ties keep the first.
 pub fn choose_noise(flight: &Flight, setup: &Setup, motion: Motion) -> Result<Noise> {
     let prep = prepare(flight, setup)?;
-    let turns: &[f64] = match motion {
-        Motion::Cv => &[0.0],
-        Motion::Ct => &TURN_GRID,
+    let (turns, priors): (&[f64], &[f64]) = match motion {
+        Motion::Cv => (&[0.0], &[0.0]),
+        Motion::Ct => (&TURN_GRID, &TURN_RATE_SD_GRID),
     };
+    let max_dt = prep
+        .kept
+        .windows(2)
+        .map(|w| flight.times[w[1]] - flight.times[w[0]])
+        .fold(0.0, f64::max);
     let mut best: Option<Noise> = None;
     for &accel in &ACCEL_GRID {
-        for &turn in turns {
+        for (&turn, &turn_rate_sd) in turns
+            .iter()
+            .flat_map(|t| priors.iter().map(move |p| (t, p)))
+        {
             let mut noise = Noise {
                 accel,
                 turn,
+                turn_rate_sd,
                 log_likelihood: f64::NEG_INFINITY,
             };
+            // a coordinated-turn Q whose turn-rate variance is negligible beside the position
+            // variance (condition number over MAX_Q_CONDITION at the longest step) is skipped:
+            // the MKPF's transition density needs a numerically positive definite Q
+            if motion == Motion::Ct && accel * max_dt * max_dt / 3.0 > MAX_Q_CONDITION * turn {
+                continue;
+            }
             // a grid point where the filter fails numerically is skipped
             if let Ok(ll) = kept_log_likelihood(&prep, flight, setup, motion, &noise)
                 && ll.is_finite()
