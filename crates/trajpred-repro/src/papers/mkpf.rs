@@ -266,7 +266,7 @@ fn noise_table(id: &str, title: &str, res: &FlightResult) -> Result<Table> {
     Ok(t)
 }
 
-fn find<'a>(res: &'a FlightResult, motion: Motion, method: Method) -> Option<&'a MethodRuns> {
+fn find(res: &FlightResult, motion: Motion, method: Method) -> Option<&MethodRuns> {
     res.rows
         .iter()
         .find(|r| r.motion == motion && r.method == method)
@@ -375,7 +375,7 @@ fn claims(
                     "{label}: the MKPF's relative error is about the paper's \
                      {PAPER_RELATIVE_ERROR_PCT}% (within a factor of two, better model)"
                 ),
-                best >= PAPER_RELATIVE_ERROR_PCT / 2.0 && best <= PAPER_RELATIVE_ERROR_PCT * 2.0,
+                (PAPER_RELATIVE_ERROR_PCT / 2.0..=PAPER_RELATIVE_ERROR_PCT * 2.0).contains(&best),
                 format!("MKPF relative error: CV {cv:.5}%, CT {ct:.5}% (paper {PAPER_RELATIVE_ERROR_PCT}%)"),
             );
         }

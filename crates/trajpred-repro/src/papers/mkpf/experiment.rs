@@ -368,6 +368,16 @@ where
     fn position_after(&self, dt: f64) -> Result<[f64; 2]>;
 }
 
+/// The filter held by the MKPF stepper, with the time step it was built for.
+type HeldMkpf<D, Tr> = Option<(f64, Mkpf<f64, D, U2, Tr, LinearObservation<f64, D, U2>>)>;
+/// The filter held by the bootstrap stepper, with the time step it was built for.
+type HeldPf<D, Tr> = Option<(
+    f64,
+    ParticleFilter<f64, D, U2, Tr, LinearObservation<f64, D, U2>>,
+)>;
+/// The best piece so far: length, flight id, times, positions, repeated reports dropped.
+type Piece = (usize, String, Vec<f64>, Vec<[f64; 2]>, usize);
+
 /// How to build the transition of a motion model for a time step.
 type MakeModel<'a, Tr> = &'a (dyn Fn(f64) -> Result<Tr> + Sync);
 
@@ -437,7 +447,7 @@ where
 {
     make: MakeModel<'a, Tr>,
     obs: LinearObservation<f64, D, U2>,
-    filter: Option<(f64, Mkpf<f64, D, U2, Tr, LinearObservation<f64, D, U2>>)>,
+    filter: HeldMkpf<D, Tr>,
     initial: Gaussian<f64, D>,
     particles: usize,
     prior: ParticlePrior,
@@ -508,10 +518,7 @@ where
 {
     make: MakeModel<'a, Tr>,
     obs: LinearObservation<f64, D, U2>,
-    filter: Option<(
-        f64,
-        ParticleFilter<f64, D, U2, Tr, LinearObservation<f64, D, U2>>,
-    )>,
+    filter: HeldPf<D, Tr>,
     initial: Gaussian<f64, D>,
     particles: usize,
     rng: ChaCha8Rng,
@@ -845,7 +852,7 @@ pub fn load_flight(dir: &Path, max_frames: Option<usize>) -> Result<FlightChoice
         ..LoadOptions::default()
     };
     let (tracks, _report) = adsb::load_file(&path, &opts)?;
-    let mut best: Option<(usize, String, Vec<f64>, Vec<[f64; 2]>, usize)> = None;
+    let mut best: Option<Piece> = None;
     for track in &tracks {
         let t = track.trajectory.times();
         let (lat, lon) = (track.trajectory.axis(0), track.trajectory.axis(1));
