@@ -89,7 +89,7 @@ impl Settings {
     fn of(ctx: &Context) -> Self {
         if ctx.quick {
             Settings {
-                n: 300,
+                n: 200,
                 dt: 0.1,
                 epochs_baseline: 1,
                 epochs_kfu: 2,
