@@ -7,7 +7,8 @@
 //! ```
 //!
 //! The first argument picks the loop (`kf`, `kf_cheap`, `kf_predict`, `kf_update`, `ads`,
-//! `ads_predict`, `ads_update`, `ukf`, `ukf_predict`, `ukf_update`, `none`), the second the
+//! `ads_predict`, `ads_update`, `ukf`, `ukf_corr` (a correlated input state), `ukf_predict`,
+//! `ukf_update`, `none`), the second the
 //! number of steps. Instructions per step: the difference of two runs with different step
 //! counts divided by the difference of the counts (`none` measures the fixed overhead).
 #![allow(non_snake_case)]
@@ -69,7 +70,10 @@ impl ObservationModel<f64, U4, U2> for AdsObservation {
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let which = args.get(1).map(String::as_str).unwrap_or("kf");
-    let steps: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1_000_000);
+    let steps: usize = args
+        .get(2)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1_000_000);
 
     let dt = 0.1;
     let tr: LinearTransition<f64, U4> =
@@ -106,12 +110,21 @@ fn main() {
         covariance: Matrix5::from_diagonal(&Vector5::new(2.0, 1.0, 2.0, 1.0, 0.01)),
     };
     let uz = Vector2::new(27.4, -0.586);
+    // a state whose turn rate is correlated with the rest (the posterior of one step): every
+    // sigma-point pair then moves the turn rate
+    let ustate_corr = ukf
+        .step(&ustate, Some(&uz))
+        .expect("step")
+        .posterior()
+        .clone();
 
     let t0 = Instant::now();
     for _ in 0..steps {
         match which {
             "kf" => {
-                let s = kf.step(black_box(&state), Some(black_box(&z))).expect("step");
+                let s = kf
+                    .step(black_box(&state), Some(black_box(&z)))
+                    .expect("step");
                 black_box(s.update.map(|u| u.posterior));
             }
             "kf_cheap" => {
@@ -156,6 +169,12 @@ fn main() {
             "ukf" => {
                 let s = ukf
                     .step(black_box(&ustate), Some(black_box(&uz)))
+                    .expect("step");
+                black_box(s.update.map(|u| u.posterior));
+            }
+            "ukf_corr" => {
+                let s = ukf
+                    .step(black_box(&ustate_corr), Some(black_box(&uz)))
                     .expect("step");
                 black_box(s.update.map(|u| u.posterior));
             }

@@ -4,13 +4,13 @@
 
 use crate::error::{KalmanError, Result};
 use crate::linalg::{
-    Chol, check_dim, check_finite, check_square, check_state, cholesky, congruence_ldl, is_static,
-    joseph, state_finite_and_symmetric, mul, mul_vec, mul_tr_sym_plus,
-    symmetrise,
+    Chol, all_finite, check_dim, check_finite, check_square, check_state, cholesky, congruence_ldl,
+    is_static, joseph, mean_finite_and_symmetric, mul, mul_tr_sym_plus, mul_vec,
+    positive_definite_shifted, symmetrise,
 };
-use crate::model::Observation;
+use crate::model::{LinearTransitionModel, Observation};
 use nalgebra::allocator::Allocator;
-use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
+use nalgebra::{Const, DefaultAllocator, Dim, OMatrix, OVector, RealField};
 use trajpred_core::Gaussian;
 
 /// How much of the input state `predict` and `update` verify.
@@ -318,17 +318,18 @@ where
 }
 
 /// The prediction of the linear KF, `x' = F x`, `P' = F P F^T + Q`, with the input checks
-/// `checks`. With `factorise` and static sizes the definiteness check of `P` is the
-/// `L D L^T` factorisation from which `F P F^T` is then formed ([`congruence_ldl`]), so the
-/// full check costs no more than the cheap one; a `P` that is only semi-definite (or fails
-/// any check) takes the check `checks` of [`validate_state`] and the plain products. The
+/// `checks`, through the model's [`LinearTransitionModel::propagate_mean`] and
+/// [`LinearTransitionModel::propagate_covariance`]. With `factorise` and static sizes the
+/// definiteness check of `P` is an `L D L^T` factorisation: for a dense `F` the one from
+/// which `F P F^T` is then formed ([`congruence_ldl`]), for a structured `F` a factorisation
+/// of its own before the cheap structured product; either way a `P` that is only
+/// semi-definite (or fails any check) takes the check `checks` of [`validate_state`]. The
 /// caller passes the same `factorise` for `predict` and `predict_own_output`, so a batch
 /// and the same steps one by one give identical results.
 #[inline(always)]
-pub(crate) fn linear_predict<T, D>(
-    f: &OMatrix<T, D, D>,
+pub(crate) fn linear_predict<T, D, Tr>(
+    tr: &Tr,
     state: &Gaussian<T, D>,
-    q: &OMatrix<T, D, D>,
     n: usize,
     factorise: bool,
     checks: InputChecks,
@@ -336,19 +337,29 @@ pub(crate) fn linear_predict<T, D>(
 where
     T: RealField + Copy,
     D: Dim,
+    Tr: LinearTransitionModel<T, D> + ?Sized,
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
+    let f = tr.transition_matrix();
     if factorise && is_static::<D, D>() {
         check_dim("state mean", n, state.mean.nrows())?;
         check_square(&state.covariance, n, "state covariance")?;
         check_dim("F rows", n, f.nrows())?;
-        let fast_ok = state_finite_and_symmetric(state);
-        if let Some(p) = congruence_ldl(f, &state.covariance, q)
-            && fast_ok
-        {
-            let mean = mul_vec(f, &state.mean);
-            check_finite(&mean, "predicted mean")?;
-            check_finite(&p, "predicted covariance")?;
+        // with the factorisation below, this proves the input finite, symmetric and
+        // positive definite
+        let fast_ok = mean_finite_and_symmetric(state);
+        let p = if tr.has_structured_propagation() {
+            (fast_ok && positive_definite_shifted(state.covariance.clone(), T::zero()))
+                .then(|| tr.propagate_covariance(&state.covariance))
+        } else {
+            congruence_ldl(f, &state.covariance, tr.process_noise()).filter(|_| fast_ok)
+        };
+        if let Some(p) = p {
+            let mean = tr.propagate_mean(&state.mean);
+            if !(all_finite(&mean) & all_finite(&p)) {
+                check_finite(&mean, "predicted mean")?;
+                check_finite(&p, "predicted covariance")?;
+            }
             return Ok(Gaussian {
                 mean,
                 covariance: p,
@@ -356,8 +367,55 @@ where
         }
     }
     validate_state(state, n, checks)?;
-    let mean = mul_vec(f, &state.mean);
-    linearized_predict(mean, f, state, q)
+    check_dim("F rows", n, f.nrows())?;
+    check_dim("F columns", n, f.ncols())?;
+    let mean = tr.propagate_mean(&state.mean);
+    let p = tr.propagate_covariance(&state.covariance);
+    check_finite(&mean, "predicted mean")?;
+    check_finite(&p, "predicted covariance")?;
+    Ok(Gaussian {
+        mean,
+        covariance: p,
+    })
+}
+
+/// `H x`, `H P` and `S = H P H^T + R` (exactly symmetric) for a linear observation model
+/// whose rows select the state components `idx`
+/// ([`LinearObservationModel::selected_components`]): picks of components, rows and a block
+/// of `P` instead of products. The caller has checked `idx.len() == m` and `idx[a] < n`.
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+pub(crate) fn selection_products<T, D, M>(
+    idx: &[usize],
+    prior: &Gaussian<T, D>,
+    r: &OMatrix<T, M, M>,
+) -> (OVector<T, M>, OMatrix<T, M, D>, OMatrix<T, M, M>)
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    DefaultAllocator:
+        Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M> + Allocator<M, D>,
+{
+    let p = &prior.covariance;
+    let (mm, _) = r.shape_generic();
+    let (dd, _) = p.shape_generic();
+    let (m, last) = (mm.value(), dd.value() - 1);
+    // `min`: the indices are < n (checked by the caller); it lets the compiler drop the
+    // bounds checks for static sizes
+    let at = |a: usize| idx[a].min(last);
+    let zp = OVector::<T, M>::from_fn_generic(mm, Const::<1>, |a, _| prior.mean[at(a)]);
+    let hp = OMatrix::<T, M, D>::from_fn_generic(mm, dd, |a, c| p[(at(a), c)]);
+    let half = nalgebra::convert::<f64, T>(0.5);
+    let mut s = OMatrix::<T, M, M>::zeros_generic(mm, mm);
+    for b in 0..m {
+        for a in b..m {
+            let v = hp[(a, at(b))] + (r[(a, b)] + r[(b, a)]) * half;
+            s[(a, b)] = v;
+            s[(b, a)] = v;
+        }
+    }
+    (zp, hp, s)
 }
 
 /// The update of a linearised observation model: `S = H P H^T + R`, `K = P H^T S^-1` by a
@@ -391,10 +449,37 @@ where
     check_dim("H columns", n, h.ncols())?;
     check_dim("h(x)", m, predicted_z.nrows())?;
     let r = observation.observation_noise();
-    let p = &prior.covariance;
-    let hp = mul(h, p);
+    let hp = mul(h, &prior.covariance);
     // S = H P H^T + R, symmetric by construction
     let s = mul_tr_sym_plus(&hp, h, r);
+    finish_update(observation, prior, predicted_z, hp, s, z, form)
+}
+
+/// The update from `H P` and `S = H P H^T + R` (symmetric): `K = P H^T S^-1` by a Cholesky
+/// solve, `x + K y`, covariance by `form`, log-likelihood from the same factor.
+#[inline(always)]
+pub(crate) fn finish_update<T, D, M, Ob>(
+    observation: &Ob,
+    prior: &Gaussian<T, D>,
+    predicted_z: &OVector<T, M>,
+    hp: OMatrix<T, M, D>,
+    s: OMatrix<T, M, M>,
+    z: &OVector<T, M>,
+    form: CovarianceUpdate,
+) -> Result<Update<T, D, M>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    Ob: Observation<T, D, M> + ?Sized,
+    DefaultAllocator: Allocator<D>
+        + Allocator<D, D>
+        + Allocator<M>
+        + Allocator<M, M>
+        + Allocator<D, M>
+        + Allocator<M, D>,
+{
+    let p = &prior.covariance;
     let chol = cholesky(s.clone(), "S")?;
     // K^T = S^-1 H P (P symmetric)
     let mut kt = hp.clone();
@@ -412,9 +497,10 @@ where
         symmetrise(&mut cov);
     }
     let log_likelihood = gaussian_log_likelihood(&chol, &y);
-    check_finite(&mean, "posterior mean")?;
-    check_finite(&cov, "posterior covariance")?;
-    if !log_likelihood.is_finite() {
+    // one branch for the three output checks; the error is located only on failure
+    if !(all_finite(&mean) & all_finite(&cov) & log_likelihood.is_finite()) {
+        check_finite(&mean, "posterior mean")?;
+        check_finite(&cov, "posterior covariance")?;
         return Err(KalmanError::NonFinite {
             what: "log-likelihood",
             index: 0,

@@ -4,10 +4,10 @@
 
 use crate::error::Result;
 use crate::filter::{
-    CovarianceUpdate, Filter, InputChecks, PredictionWithCross, Smoother, Update,
-    linear_predict, linearized_predict, linearized_update, validate_state,
+    CovarianceUpdate, Filter, InputChecks, PredictionWithCross, Smoother, Update, finish_update,
+    linear_predict, linearized_predict, linearized_update, selection_products, validate_state,
 };
-use crate::linalg::{check_dim, mul_vec};
+use crate::linalg::{check_dim, check_finite, mul_vec};
 use crate::model::{
     LinearObservationModel, LinearTransitionModel, ObservationJacobian, TransitionJacobian,
     validate_models,
@@ -40,6 +40,8 @@ pub struct Kf<Tr, Ob> {
     observation: Ob,
     covariance_update: CovarianceUpdate,
     checks: InputChecks,
+    /// The observation selects state components (checked against the sizes once, here).
+    selection: bool,
 }
 
 impl<Tr, Ob> Kf<Tr, Ob> {
@@ -62,11 +64,16 @@ impl<Tr, Ob> Kf<Tr, Ob> {
             transition.state_dim(),
             observation.observation_matrix().ncols(),
         )?;
+        let (n, m) = (transition.state_dim(), observation.observation_dim());
+        let selection = observation
+            .selected_components()
+            .is_some_and(|idx| idx.len() == m && idx.iter().all(|&i| i < n));
         Ok(Kf {
             transition,
             observation,
             covariance_update: CovarianceUpdate::Joseph,
             checks: InputChecks::Full,
+            selection,
         })
     }
 
@@ -115,9 +122,8 @@ where
     #[inline(always)]
     fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
         linear_predict(
-            self.transition.transition_matrix(),
+            &self.transition,
             state,
-            self.transition.process_noise(),
             self.transition.state_dim(),
             self.checks == InputChecks::Full,
             self.checks,
@@ -126,9 +132,8 @@ where
 
     fn predict_own_output(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
         linear_predict(
-            self.transition.transition_matrix(),
+            &self.transition,
             state,
-            self.transition.process_noise(),
             self.transition.state_dim(),
             self.checks == InputChecks::Full,
             InputChecks::Cheap,
@@ -147,6 +152,22 @@ where
         z: &OVector<T, M>,
     ) -> Result<Update<T, D, M>> {
         check_dim("prior", self.transition.state_dim(), prior.mean.nrows())?;
+        if self.selection
+            && let Some(idx) = self.observation.selected_components()
+        {
+            check_dim("observation", self.observation.observation_dim(), z.nrows())?;
+            check_finite(z, "observation")?;
+            let (zp, hp, s) = selection_products(idx, prior, self.observation.observation_noise());
+            return finish_update(
+                &self.observation,
+                prior,
+                &zp,
+                hp,
+                s,
+                z,
+                self.covariance_update,
+            );
+        }
         let h = self.observation.observation_matrix();
         let zp = mul_vec(h, &prior.mean);
         linearized_update(&self.observation, prior, &zp, h, z, self.covariance_update)

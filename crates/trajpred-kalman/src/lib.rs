@@ -114,7 +114,7 @@ pub use filter::{
 pub use kf::{Ekf, Kf};
 pub use model::{
     LinearObservation, LinearObservationModel, LinearTransition, LinearTransitionModel,
-    Observation, ObservationJacobian, Transition, TransitionJacobian,
+    Observation, ObservationJacobian, SigmaImages, Transition, TransitionJacobian,
 };
 pub mod ukf;
 pub use ukf::{MerweSigmaPoints, SigmaWeights, Ukf};

@@ -163,8 +163,7 @@ where
     T: RealField + Copy,
     D: Dim,
     M: Dim,
-    DefaultAllocator:
-        Allocator<D, D> + Allocator<D, M> + Allocator<M, D> + Allocator<M, M>,
+    DefaultAllocator: Allocator<D, D> + Allocator<D, M> + Allocator<M, D> + Allocator<M, M>,
 {
     if is_static::<D, M>() && M::try_to_usize() != Some(0) {
         let (d, m) = k.shape_generic();
@@ -309,14 +308,15 @@ where
     #[inline(always)]
     pub(crate) fn new(mut a: OMatrix<T, D, D>) -> Option<Self> {
         let n = a.nrows();
+        // one verdict without branches, as in `positive_definite_shifted`
+        let big = T::max_value().unwrap_or(T::one() / T::zero());
+        let mut ok = true;
         for j in 0..n {
             let mut d = a[(j, j)];
             for k in 0..j {
                 d -= a[(j, k)] * a[(j, k)];
             }
-            if d <= T::zero() || !d.is_finite() {
-                return None;
-            }
+            ok &= (d > T::zero()) & (d <= big);
             let ljj = d.sqrt();
             a[(j, j)] = ljj;
             for i in (j + 1)..n {
@@ -330,7 +330,7 @@ where
                 a[(i, j)] = T::zero();
             }
         }
-        Some(Chol { l: a })
+        ok.then_some(Chol { l: a })
     }
 
     /// The factor `L`, by value.
@@ -490,18 +490,28 @@ where
     ok
 }
 
-/// The fast part of [`check_state`] for the factorising predict: finite mean and `P`, `P`
-/// symmetric to [`symmetry_tolerance`] (definiteness is left to the factorisation).
+/// The fast check of a state for the factorising predict, **to be combined with a
+/// successful `L D L^T` factorisation of `P`** (which reads the lower triangle and fails on a
+/// non-finite or non-positive pivot, so it already proves the lower triangle finite and
+/// positive definite): a finite mean, and `P` symmetric to [`symmetry_tolerance`] of the
+/// largest diagonal element (for a positive definite matrix the largest magnitude is on the
+/// diagonal). A non-finite upper element fails the symmetry test (the tolerance is finite
+/// whenever the factorisation succeeded), so no separate finiteness pass over `P` is needed.
 #[inline(always)]
-pub(crate) fn state_finite_and_symmetric<T, D>(state: &Gaussian<T, D>) -> bool
+pub(crate) fn mean_finite_and_symmetric<T, D>(state: &Gaussian<T, D>) -> bool
 where
     T: RealField + Copy,
     D: Dim,
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     let p = &state.covariance;
-    let tol = symmetry_tolerance(amax_finite(p));
-    let mut ok = all_finite(&state.mean) & all_finite(p);
+    let mut scale = T::zero();
+    for j in 0..p.nrows() {
+        let v = p[(j, j)];
+        scale = if v > scale { v } else { scale };
+    }
+    let tol = symmetry_tolerance(scale);
+    let mut ok = all_finite(&state.mean);
     for j in 0..p.nrows() {
         for i in 0..j {
             ok &= (p[(i, j)] - p[(j, i)]).abs() <= tol;
@@ -556,6 +566,10 @@ where
     DefaultAllocator: Allocator<D, D>,
 {
     let n = a.nrows();
+    // `0 < d <= max` is false for a NaN or infinite pivot too: one verdict accumulated
+    // without branches (after a bad pivot the remaining arithmetic is harmless)
+    let big = T::max_value().unwrap_or(T::one() / T::zero());
+    let mut ok = true;
     for j in 0..n {
         // row j of L is in a[(j, k)], k < j; w_k = L_jk d_k goes to the unused a[(k, j)]
         let mut d = a[(j, j)] + shift;
@@ -564,9 +578,7 @@ where
             a[(k, j)] = w;
             d -= a[(j, k)] * w;
         }
-        if d <= T::zero() || !d.is_finite() {
-            return false;
-        }
+        ok &= (d > T::zero()) & (d <= big);
         a[(j, j)] = d;
         let inv = T::one() / d;
         for i in (j + 1)..n {
@@ -577,7 +589,7 @@ where
             a[(i, j)] = s * inv;
         }
     }
-    true
+    ok
 }
 
 /// Checks that `m` is symmetric positive definite (its Cholesky factor exists).

@@ -16,9 +16,75 @@
 //! filters (the MKPF proposal runs a UKF step and an EKF step on the same models).
 
 use crate::error::Result;
-use crate::linalg::{check_dim, check_finite, check_pd, check_psd, check_square};
+use crate::linalg::{
+    check_dim, check_finite, check_pd, check_psd, check_square, mul, mul_tr_sym_plus, mul_vec,
+};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
+
+/// A function `g` evaluated at the `2n + 1` symmetric sigma points `x`, `x + L_j`,
+/// `x - L_j` (`L_j` the columns of a lower-triangular `L`): `g(x)`, and the matrices whose
+/// column `j` is `g(x + L_j)`, respectively `g(x - L_j)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SigmaImages<T: RealField, D: Dim, E: Dim>
+where
+    DefaultAllocator: Allocator<E> + Allocator<E, D>,
+{
+    /// `g(x)`.
+    pub center: OVector<T, E>,
+    /// Column `j`: `g(x + L_j)`.
+    pub plus: OMatrix<T, E, D>,
+    /// Column `j`: `g(x - L_j)`.
+    pub minus: OMatrix<T, E, D>,
+}
+
+/// The per-point evaluation of [`SigmaImages`]: `g` once per sigma point, with one point
+/// buffer (`L` lower triangular: `x +- L_j` differ from `x` only in rows `j..n`).
+#[inline(always)]
+pub(crate) fn sigma_images_per_point<T, D, E, G>(
+    x: &OVector<T, D>,
+    l: &OMatrix<T, D, D>,
+    g: G,
+) -> Result<SigmaImages<T, D, E>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    E: Dim,
+    G: Fn(&OVector<T, D>) -> Result<OVector<T, E>>,
+    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<E> + Allocator<E, D>,
+{
+    let n = x.nrows();
+    check_dim("sigma-point spread", n, l.nrows())?;
+    check_dim("sigma-point spread", n, l.ncols())?;
+    let center = g(x)?;
+    let e = center.shape_generic().0;
+    let d = x.shape_generic().0;
+    let mut plus = OMatrix::<T, E, D>::zeros_generic(e, d);
+    let mut minus = OMatrix::<T, E, D>::zeros_generic(e, d);
+    let mut pt = x.clone();
+    for j in 0..n {
+        for i in j..n {
+            pt[i] = x[i] + l[(i, j)];
+        }
+        let yp = g(&pt)?;
+        check_dim("transformed sigma point", e.value(), yp.nrows())?;
+        plus.set_column(j, &yp);
+        for i in j..n {
+            pt[i] = x[i] - l[(i, j)];
+        }
+        let ym = g(&pt)?;
+        check_dim("transformed sigma point", e.value(), ym.nrows())?;
+        minus.set_column(j, &ym);
+        for i in j..n {
+            pt[i] = x[i];
+        }
+    }
+    Ok(SigmaImages {
+        center,
+        plus,
+        minus,
+    })
+}
 
 /// A state transition `x(k+1) = f(x(k)) + w`, `w ~ N(0, Q)`.
 pub trait Transition<T: RealField + Copy, D: Dim>
@@ -42,6 +108,19 @@ where
     fn state_residual(&self, a: &OVector<T, D>, b: &OVector<T, D>) -> OVector<T, D> {
         a - b
     }
+
+    /// `f` at the sigma points `x`, `x +- L_j` of a lower-triangular `L` (the UKF's
+    /// predict). By default one [`Transition::transition`] call per point; a model may
+    /// override it to share work between points (the coordinated turn shares `sin`/`cos`
+    /// of the turn angle by the angle-addition formulas). The result must equal the
+    /// per-point one up to rounding.
+    fn transition_sigma_points(
+        &self,
+        x: &OVector<T, D>,
+        l: &OMatrix<T, D, D>,
+    ) -> Result<SigmaImages<T, D, D>> {
+        sigma_images_per_point(x, l, |p| self.transition(p))
+    }
 }
 
 /// A [`Transition`] with its Jacobian `F(x) = df/dx`, needed by the EKF.
@@ -60,6 +139,31 @@ where
 {
     /// The transition matrix `F`.
     fn transition_matrix(&self) -> &OMatrix<T, D, D>;
+
+    /// The predicted mean `F x`. By default the dense product; a model with a structured
+    /// `F` may override it (the result must equal `F x` up to rounding).
+    #[inline(always)]
+    fn propagate_mean(&self, x: &OVector<T, D>) -> OVector<T, D> {
+        mul_vec(self.transition_matrix(), x)
+    }
+
+    /// The predicted covariance `F P F^T + (Q + Q^T) / 2`, exactly symmetric (the lower
+    /// triangle is formed and mirrored), for a symmetric `P`. By default the dense
+    /// products; a model with a structured `F` may override it (constant velocity and
+    /// constant acceleration do, through [`LinearTransition`]'s structure detection).
+    #[inline(always)]
+    fn propagate_covariance(&self, p: &OMatrix<T, D, D>) -> OMatrix<T, D, D> {
+        let f = self.transition_matrix();
+        mul_tr_sym_plus(&mul(f, p), f, self.process_noise())
+    }
+
+    /// `true` when [`LinearTransitionModel::propagate_covariance`] exploits a structure of
+    /// `F` (cheaper than the dense products). The KF then checks `P` by a factorisation of
+    /// its own before propagating it; otherwise (the default) it fuses the check with the
+    /// dense products (`F L D L^T F^T` from `P = L D L^T`).
+    fn has_structured_propagation(&self) -> bool {
+        false
+    }
 }
 
 /// An observation `z = h(x) + v`, `v ~ N(0, R)`, of dimension `M`.
@@ -89,6 +193,21 @@ where
     fn normalize_observation(&self, z: OVector<T, M>) -> OVector<T, M> {
         z
     }
+
+    /// `h` at the sigma points `x`, `x +- L_j` of a lower-triangular `L` (the UKF's update).
+    /// By default one [`Observation::observe`] call per point; a model may override it to
+    /// share work between points (range-bearing reuses `h(x)` for the points that do not
+    /// move the position). The result must equal the per-point one up to rounding.
+    fn observe_sigma_points(
+        &self,
+        x: &OVector<T, D>,
+        l: &OMatrix<T, D, D>,
+    ) -> Result<SigmaImages<T, D, M>>
+    where
+        DefaultAllocator: Allocator<M, D>,
+    {
+        sigma_images_per_point(x, l, |p| self.observe(p))
+    }
 }
 
 /// An [`Observation`] with its Jacobian `H(x) = dh/dx` (an `m x n` matrix), needed by the EKF.
@@ -110,6 +229,14 @@ where
 {
     /// The observation matrix `H`.
     fn observation_matrix(&self) -> &OMatrix<T, M, D>;
+
+    /// When every row `a` of `H` is the unit vector selecting state component `idx[a]`
+    /// (a position observation), the indices `idx` (one per observation component): the
+    /// KF then forms `H x`, `H P` and `H P H^T` by picking components instead of products.
+    /// `None` (the default) for a general `H`.
+    fn selected_components(&self) -> Option<&[usize]> {
+        None
+    }
 }
 
 // ---- references -----------------------------------------------------------------------------
@@ -130,6 +257,13 @@ where
     fn state_residual(&self, a: &OVector<T, D>, b: &OVector<T, D>) -> OVector<T, D> {
         (**self).state_residual(a, b)
     }
+    fn transition_sigma_points(
+        &self,
+        x: &OVector<T, D>,
+        l: &OMatrix<T, D, D>,
+    ) -> Result<SigmaImages<T, D, D>> {
+        (**self).transition_sigma_points(x, l)
+    }
 }
 
 impl<T: RealField + Copy, D: Dim, X: TransitionJacobian<T, D> + ?Sized> TransitionJacobian<T, D>
@@ -149,6 +283,17 @@ where
 {
     fn transition_matrix(&self) -> &OMatrix<T, D, D> {
         (**self).transition_matrix()
+    }
+    #[inline(always)]
+    fn propagate_mean(&self, x: &OVector<T, D>) -> OVector<T, D> {
+        (**self).propagate_mean(x)
+    }
+    #[inline(always)]
+    fn propagate_covariance(&self, p: &OMatrix<T, D, D>) -> OMatrix<T, D, D> {
+        (**self).propagate_covariance(p)
+    }
+    fn has_structured_propagation(&self) -> bool {
+        (**self).has_structured_propagation()
     }
 }
 
@@ -172,6 +317,16 @@ where
     fn normalize_observation(&self, z: OVector<T, M>) -> OVector<T, M> {
         (**self).normalize_observation(z)
     }
+    fn observe_sigma_points(
+        &self,
+        x: &OVector<T, D>,
+        l: &OMatrix<T, D, D>,
+    ) -> Result<SigmaImages<T, D, M>>
+    where
+        DefaultAllocator: Allocator<M, D>,
+    {
+        (**self).observe_sigma_points(x, l)
+    }
 }
 
 impl<T: RealField + Copy, D: Dim, M: Dim, X: ObservationJacobian<T, D, M> + ?Sized>
@@ -194,6 +349,9 @@ where
     fn observation_matrix(&self) -> &OMatrix<T, M, D> {
         (**self).observation_matrix()
     }
+    fn selected_components(&self) -> Option<&[usize]> {
+        (**self).selected_components()
+    }
 }
 
 // ---- linear models --------------------------------------------------------------------------
@@ -214,6 +372,37 @@ where
 {
     f: OMatrix<T, D, D>,
     q: OMatrix<T, D, D>,
+    /// `F = I + N` with few non-zeros in `N` (constant velocity, constant acceleration):
+    /// the non-zeros `(row, column, value)` of `N`; `None` for a general `F`.
+    shift: Option<Vec<(usize, usize, T)>>,
+    /// `(Q + Q^T) / 2`, for the structured propagation.
+    q_sym: OMatrix<T, D, D>,
+}
+
+/// The off-diagonal non-zeros of `F` when its diagonal is all ones and there are at most
+/// `n` of them (the kinematic models: `n / 2` for constant velocity, `n` for constant
+/// acceleration); `None` otherwise.
+fn unit_plus_sparse<T, D>(f: &OMatrix<T, D, D>) -> Option<Vec<(usize, usize, T)>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D>,
+{
+    let n = f.nrows();
+    let mut out = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let v = f[(i, j)];
+            if i == j {
+                if v != T::one() {
+                    return None;
+                }
+            } else if v != T::zero() {
+                out.push((i, j, v));
+            }
+        }
+    }
+    (out.len() <= n).then_some(out)
 }
 
 impl<T: RealField + Copy, D: Dim> LinearTransition<T, D>
@@ -230,7 +419,9 @@ where
         check_square(&q, n, "Q vs F")?;
         check_finite(&f, "F")?;
         check_psd(&q, "Q")?;
-        Ok(LinearTransition { f, q })
+        let shift = unit_plus_sparse(&f);
+        let q_sym = (&q + q.transpose()) * nalgebra::convert::<f64, T>(0.5);
+        Ok(LinearTransition { f, q, shift, q_sym })
     }
 
     /// The transition matrix `F`.
@@ -273,6 +464,64 @@ where
     fn transition_matrix(&self) -> &OMatrix<T, D, D> {
         &self.f
     }
+
+    /// `x + N x` over the non-zeros of `N` when `F = I + N` is sparse.
+    #[inline(always)]
+    fn propagate_mean(&self, x: &OVector<T, D>) -> OVector<T, D> {
+        match &self.shift {
+            Some(shift) => {
+                let mut out = x.clone();
+                let last = x.nrows() - 1;
+                for &(i, j, a) in shift {
+                    // indices < n by construction; the `min` lets the compiler drop the
+                    // bounds checks for static sizes
+                    let (i, j) = (i.min(last), j.min(last));
+                    out[i] += a * x[j];
+                }
+                out
+            }
+            None => mul_vec(&self.f, x),
+        }
+    }
+
+    /// With `F = I + N` sparse: `M = P + N P` (row updates), `M F^T = M + M N^T` (column
+    /// updates), then the lower triangle plus `(Q + Q^T) / 2`, mirrored (exactly
+    /// symmetric).
+    #[inline(always)]
+    fn propagate_covariance(&self, p: &OMatrix<T, D, D>) -> OMatrix<T, D, D> {
+        let Some(shift) = &self.shift else {
+            return mul_tr_sym_plus(&mul(&self.f, p), &self.f, &self.q);
+        };
+        let n = p.nrows();
+        let last = n - 1;
+        let mut m = p.clone();
+        for &(i, j, a) in shift {
+            // indices < n by construction; the `min` drops the bounds checks
+            let (i, j) = (i.min(last), j.min(last));
+            for c in 0..n {
+                m[(i, c)] += a * p[(j, c)];
+            }
+        }
+        let mut out = m.clone();
+        for &(i, j, a) in shift {
+            let (i, j) = (i.min(last), j.min(last));
+            for r in 0..n {
+                out[(r, i)] += a * m[(r, j)];
+            }
+        }
+        for j in 0..n {
+            for i in j..n {
+                let v = out[(i, j)] + self.q_sym[(i, j)];
+                out[(i, j)] = v;
+                out[(j, i)] = v;
+            }
+        }
+        out
+    }
+
+    fn has_structured_propagation(&self) -> bool {
+        self.shift.is_some()
+    }
 }
 
 /// The linear observation `z = H x + v`, `v ~ N(0, R)`, validated at construction.
@@ -291,6 +540,8 @@ where
 {
     h: OMatrix<T, M, D>,
     r: OMatrix<T, M, M>,
+    /// The state component each row of `H` selects, when every row is a unit vector.
+    selection: Option<Vec<usize>>,
 }
 
 impl<T: RealField + Copy, D: Dim, M: Dim> LinearObservation<T, D, M>
@@ -306,7 +557,19 @@ where
         check_square(&r, h.nrows(), "R vs H")?;
         check_finite(&h, "H")?;
         check_pd(&r, "R")?;
-        Ok(LinearObservation { h, r })
+        let selection = (0..h.nrows())
+            .map(|a| {
+                let row = h.row(a);
+                let ones = row.iter().filter(|&&v| v == T::one()).count();
+                let zeros = row.iter().filter(|&&v| v == T::zero()).count();
+                if ones == 1 && zeros + 1 == row.len() {
+                    row.iter().position(|&v| v == T::one())
+                } else {
+                    None
+                }
+            })
+            .collect::<Option<Vec<usize>>>();
+        Ok(LinearObservation { h, r, selection })
     }
 
     /// The observation matrix `H`.
@@ -353,6 +616,9 @@ where
 {
     fn observation_matrix(&self) -> &OMatrix<T, M, D> {
         &self.h
+    }
+    fn selected_components(&self) -> Option<&[usize]> {
+        self.selection.as_deref()
     }
 }
 

@@ -7,7 +7,7 @@ use crate::filter::{
     validate_state,
 };
 use crate::linalg::{check_dim, check_finite, cholesky, mul, mul_tr_sym_plus, mul_vec, symmetrise};
-use crate::model::{Observation, Transition, validate_models};
+use crate::model::{Observation, SigmaImages, Transition, validate_models};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
 use trajpred_core::Gaussian;
@@ -164,14 +164,15 @@ where
     cross: OMatrix<T, D, E>,
 }
 
-/// The unscented transform with symmetric points: the mean is computed as
+/// The unscented transform with symmetric points, from the images `g(x)`, `g(x +- L_j)`
+/// of the sigma points ([`SigmaImages`]): the mean is computed as
 /// `g(x) + sum_i Wi residual(g(x_i), g(x))` (equal to `sum_i Wm_i g(x_i)` for a linear
 /// residual, and a correct circular mean when `residual` wraps angles), the spread with
 /// `residual(g(x_i), mean)`.
-fn unscented_transform<T, D, E, G, R>(
-    state: &Gaussian<T, D>,
+fn unscented_transform<T, D, E, R>(
+    l: &OMatrix<T, D, D>,
+    images: SigmaImages<T, D, E>,
     w: &SigmaWeights<T>,
-    g: G,
     residual: R,
     with_cross: bool,
 ) -> Result<Transformed<T, D, E>>
@@ -179,7 +180,6 @@ where
     T: RealField + Copy,
     D: Dim,
     E: Dim,
-    G: Fn(&OVector<T, D>) -> Result<OVector<T, E>>,
     R: Fn(&OVector<T, E>, &OVector<T, E>) -> OVector<T, E>,
     DefaultAllocator: Allocator<D>
         + Allocator<D, D>
@@ -188,36 +188,23 @@ where
         + Allocator<E, D>
         + Allocator<D, E>,
 {
-    let n = state.mean.nrows();
-    let l = w.spread(&state.covariance)?;
-    let y0 = g(&state.mean)?;
+    let SigmaImages {
+        center: y0,
+        plus,
+        minus,
+    } = images;
+    let n = l.nrows();
     let e = y0.shape_generic().0;
-    let d = state.mean.shape_generic().0;
+    let d = l.shape_generic().0;
     let ne = e.value();
-    let mut plus = OMatrix::<T, E, D>::zeros_generic(e, d);
-    let mut minus = OMatrix::<T, E, D>::zeros_generic(e, d);
+    check_dim("transformed sigma points", ne, plus.nrows())?;
+    check_dim("transformed sigma points", n, plus.ncols())?;
+    check_dim("transformed sigma points", ne, minus.nrows())?;
+    check_dim("transformed sigma points", n, minus.ncols())?;
     let mut sum = OVector::<T, E>::zeros_generic(e, nalgebra::Const::<1>);
-    // one sigma point buffer on the stack (static sizes); L is lower triangular, so the
-    // points x +- L_j differ from x only in rows j..n
-    let mut x = state.mean.clone();
     for j in 0..n {
-        for i in j..n {
-            x[i] = state.mean[i] + l[(i, j)];
-        }
-        let yp = g(&x)?;
-        check_dim("transformed sigma point", ne, yp.nrows())?;
-        sum += residual(&yp, &y0);
-        plus.set_column(j, &yp);
-        for i in j..n {
-            x[i] = state.mean[i] - l[(i, j)];
-        }
-        let ym = g(&x)?;
-        check_dim("transformed sigma point", ne, ym.nrows())?;
-        sum += residual(&ym, &y0);
-        minus.set_column(j, &ym);
-        for i in j..n {
-            x[i] = state.mean[i];
-        }
+        sum += residual(&plus.column(j).into_owned(), &y0);
+        sum += residual(&minus.column(j).into_owned(), &y0);
     }
     let mean = &y0 + sum * w.other;
     // the weighted spread: lower triangle accumulated column by column, then mirrored
@@ -360,10 +347,12 @@ where
         check_dim("observation", m, z.nrows())?;
         check_finite(z, "observation")?;
         let ob = &self.observation;
+        let l = self.weights.spread(&prior.covariance)?;
+        let images = ob.observe_sigma_points(&prior.mean, &l)?;
         let t = unscented_transform(
-            prior,
+            &l,
+            images,
             &self.weights,
-            |x| ob.observe(x),
             |a, b| ob.observation_residual(a, b),
             true,
         )?;
@@ -435,10 +424,12 @@ impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
         let n = self.transition.state_dim();
         validate_state(filtered, n, UKF_CHECKS)?;
         let tr = &self.transition;
+        let l = self.weights.spread(&filtered.covariance)?;
+        let images = tr.transition_sigma_points(&filtered.mean, &l)?;
         let t = unscented_transform(
-            filtered,
+            &l,
+            images,
             &self.weights,
-            |x| tr.transition(x),
             |a, b| tr.state_residual(a, b),
             with_cross,
         )?;

@@ -611,3 +611,116 @@ fn augmented_ukf_with_multiplicative_noise_by_hand() {
     assert!((u.posterior.mean[0] - (2.0 + 0.9 / 1.9)).abs() < 1e-12);
     assert!((u.posterior.covariance[(0, 0)] - (0.9 - 0.81 / 1.9)).abs() < 1e-12);
 }
+
+#[test]
+fn structured_propagation_equals_the_dense_products() {
+    use nalgebra::Dyn;
+    use trajpred_kalman::LinearTransitionModel;
+    for derivatives in [2usize, 3] {
+        for axes in 1..=3 {
+            for order in [StateOrder::AxisBlocks, StateOrder::PositionsFirst] {
+                let n = axes * derivatives;
+                let tr: LinearTransition<f64, Dyn> = if derivatives == 2 {
+                    constant_velocity(axes, 0.3, 0.7, order).unwrap()
+                } else {
+                    constant_acceleration(axes, 0.3, 0.7, order).unwrap()
+                };
+                assert!(tr.has_structured_propagation());
+                let a = DMatrix::from_fn(n, n, |i, j| ((i * 7 + j * 3) % 5) as f64 * 0.3 - 0.5);
+                let p = &a * a.transpose() + DMatrix::identity(n, n);
+                let x = DVector::from_fn(n, |i, _| i as f64 - 1.5);
+                let (f, q) = (tr.f(), tr.q());
+                let dense = f * &p * f.transpose() + (q + q.transpose()) * 0.5;
+                let got = tr.propagate_covariance(&p);
+                assert_close(&got, &dense, 1e-13, "F P F^T + Q");
+                assert_eq!(got, got.transpose(), "exactly symmetric");
+                assert_close(&tr.propagate_mean(&x), &(f * &x), 1e-14, "F x");
+            }
+        }
+    }
+    // a general F keeps the dense products
+    let dense =
+        LinearTransition::new(Matrix2::new(0.9, 0.1, -0.2, 1.0), Matrix2::identity()).unwrap();
+    assert!(!dense.has_structured_propagation());
+}
+
+#[test]
+fn selection_update_equals_the_general_update() {
+    // the KF picks H x, H P, H P H^T for a position observation; the EKF with the same
+    // linear models takes the general products
+    for order in [StateOrder::AxisBlocks, StateOrder::PositionsFirst] {
+        let tr: LinearTransition<f64, U4> = constant_velocity(2, 0.1, 0.5, order).unwrap();
+        let layout = KinematicLayout::new(2, 2, order).unwrap();
+        let ob: LinearObservation<f64, U4, U2> = position_observation(layout, 0.3).unwrap();
+        use trajpred_kalman::LinearObservationModel;
+        assert!(ob.selected_components().is_some());
+        let kf = Kf::new(&tr, &ob).unwrap();
+        let ekf = Ekf::new(&tr, &ob).unwrap();
+        let a = Matrix4::from_fn(|i, j| ((i * 5 + j * 3) % 7) as f64 * 0.2 - 0.6);
+        let prior = Gaussian {
+            mean: Vector4::new(1.0, 0.5, -2.0, 0.3),
+            covariance: a * a.transpose() + Matrix4::identity() * 0.1,
+        };
+        let z = Vector2::new(1.07, -1.95);
+        let (u, v) = (
+            kf.update(&prior, &z).unwrap(),
+            ekf.update(&prior, &z).unwrap(),
+        );
+        assert_close(&u.posterior.mean, &v.posterior.mean, 1e-13, "mean");
+        assert_close(&u.posterior.covariance, &v.posterior.covariance, 1e-13, "P");
+        assert_close(
+            &u.innovation_covariance,
+            &v.innovation_covariance,
+            1e-14,
+            "S",
+        );
+        assert_close(&u.gain, &v.gain, 1e-13, "K");
+        assert!((u.log_likelihood - v.log_likelihood).abs() < 1e-12);
+    }
+    // a general H is not a selection
+    let ob = LinearObservation::new(Matrix1x2::new(1.0, 0.5), Matrix1::new(0.25)).unwrap();
+    use trajpred_kalman::LinearObservationModel;
+    assert!(ob.selected_components().is_none());
+}
+
+#[test]
+fn batch_sigma_point_images_equal_the_per_point_ones() {
+    let ct = CoordinatedTurn::new(0.5, 0.2, 1e-3).unwrap();
+    let rb = RangeBearing::new(Vector2::new(-20.0, 15.0), 0, 2, 0.5, 1e-3).unwrap();
+    let x = Vector5::new(0.5, 7.0, -0.5, 2.5, 0.1);
+    // a lower-triangular spread with the turn rate correlated to everything, and one with
+    // the turn rate uncorrelated (shared sin/cos) and a zero turn rate (series branch)
+    let full = Matrix5::from_fn(|i, j| {
+        if i >= j {
+            0.3 + 0.1 * (i + 2 * j) as f64
+        } else {
+            0.0
+        }
+    });
+    let mut diag = Matrix5::from_diagonal(&Vector5::new(1.4, 1.0, 1.4, 1.0, 0.1));
+    diag[(4, 4)] = 0.1;
+    for (l, x) in [
+        (full, x),
+        (diag, x),
+        (full, Vector5::new(0.5, 7.0, -0.5, 2.5, 0.0)),
+    ] {
+        let t = ct.transition_sigma_points(&x, &l).unwrap();
+        let o = rb.observe_sigma_points(&x, &l).unwrap();
+        assert_close(&t.center, &ct.transition(&x).unwrap(), 1e-14, "f(x)");
+        assert_close(
+            &o.center,
+            &Observation::<f64, Const<5>, U2>::observe(&rb, &x).unwrap(),
+            1e-14,
+            "h(x)",
+        );
+        for j in 0..5 {
+            for (sign, img, oimg) in [(1.0, &t.plus, &o.plus), (-1.0, &t.minus, &o.minus)] {
+                let xj = x + l.column(j) * sign;
+                let want = ct.transition(&xj).unwrap();
+                assert_close(&img.column(j).into_owned(), &want, 1e-12, "f(x +- L_j)");
+                let want = Observation::<f64, Const<5>, U2>::observe(&rb, &xj).unwrap();
+                assert_close(&oimg.column(j).into_owned(), &want, 1e-14, "h(x +- L_j)");
+            }
+        }
+    }
+}
