@@ -41,7 +41,7 @@ fn main() {
     .expect("valid config");
     model
         .fit_with(&data, &mut |r| {
-            println!(
+            eprintln!(
                 "epoch {:3}  {:.4} s  loss {:.6}",
                 r.epoch,
                 r.elapsed.as_secs_f64(),

@@ -346,7 +346,9 @@ impl Architecture for LstmArch {
         let h = match states.pop().flatten() {
             Some(s) => s.hidden,
             // no layer or an empty window (both rejected by validation)
-            None => x.slice([0..b, m.saturating_sub(1)..m, 0..f]).reshape([b, f]),
+            None => x
+                .slice([0..b, m.saturating_sub(1)..m, 0..f])
+                .reshape([b, f]),
         };
         net.head.forward(h)
     }
