@@ -217,22 +217,25 @@ impl FusedLstm {
     }
 
     /// One step from the input projection `xw = x W_ih + b` (`[batch, 4 hidden]`).
+    ///
+    /// One sigmoid over all four gate blocks (the cell block's sigmoid is not used) instead
+    /// of one per gate: on the CPU backend an operation costs mostly its fixed overhead, and
+    /// burn's autodiff recomputes a sigmoid in the backward pass.
     fn step(&self, xw: Tensor<2>, state: Option<LstmCellState>) -> LstmCellState {
         let gates = match &state {
             Some(s) => xw + self.recurrent.forward(s.hidden.clone()),
             None => xw,
         };
         let h = self.d_hidden;
-        let i = gates.clone().narrow(1, 0, h);
-        let f = gates.clone().narrow(1, h, h);
-        let c_new = gates.clone().narrow(1, 2 * h, h);
-        let o = gates.narrow(1, 3 * h, h);
-        let ic = sigmoid(i) * tanh(c_new);
+        let act = sigmoid(gates.clone());
+        let i = act.clone().narrow(1, 0, h);
+        let o = act.clone().narrow(1, 3 * h, h);
+        let ic = i * tanh(gates.narrow(1, 2 * h, h));
         let cell = match state {
-            Some(s) => sigmoid(f) * s.cell + ic,
+            Some(s) => act.narrow(1, h, h) * s.cell + ic,
             None => ic,
         };
-        let hidden = sigmoid(o) * tanh(cell.clone());
+        let hidden = o * tanh(cell.clone());
         LstmCellState { cell, hidden }
     }
 
@@ -243,24 +246,26 @@ impl FusedLstm {
 
     /// Runs over `x: [batch, steps, d_input]`; returns every hidden state
     /// `[batch, steps, hidden]` and the final state.
+    ///
+    /// The input product is taken step by step: slicing a whole-sequence product of a
+    /// tracked tensor would cost, in the backward pass, one zero-filled full-sequence
+    /// gradient per step.
     pub fn forward(
         &self,
         x: Tensor<3>,
         state: Option<LstmCellState>,
     ) -> (Tensor<3>, LstmCellState) {
-        let [b, m, _] = x.dims();
-        let xw = self.input.forward(x);
-        let h4 = 4 * self.d_hidden;
+        let [b, m, d] = x.dims();
         let mut state = state;
         let mut outs = Vec::with_capacity(m);
         for t in 0..m {
-            let xt = xw.clone().slice([0..b, t..t + 1, 0..h4]).reshape([b, h4]);
-            let s = self.step(xt, state);
+            let xt = x.clone().slice([0..b, t..t + 1, 0..d]).reshape([b, d]);
+            let s = self.forward_step(xt, state);
             outs.push(s.hidden.clone());
             state = Some(s);
         }
         let last = state.unwrap_or_else(|| {
-            let z = Tensor::zeros([b, self.d_hidden], &xw.device());
+            let z = Tensor::zeros([b, self.d_hidden], &x.device());
             LstmCellState {
                 cell: z.clone(),
                 hidden: z,
@@ -324,18 +329,27 @@ impl Architecture for LstmArch {
             head: Head::new(d, &self.0.fc, outputs, self.0.activation, device),
         }
     }
-    fn forward(&self, net: &LstmStack, mut x: Tensor<3>) -> Tensor<2> {
-        let [b, _, _] = x.dims();
-        let mut last = None;
-        for l in &net.layers {
-            let (out, state) = l.forward(x, None);
-            x = out;
-            last = Some(state.hidden);
+    /// Step by step through all layers at once (layer `l` at step `t` reads layer `l - 1`
+    /// at step `t`): only the last layer's final hidden state is used, so no layer's
+    /// sequence of hidden states is stacked and sliced again.
+    fn forward(&self, net: &LstmStack, x: Tensor<3>) -> Tensor<2> {
+        let [b, m, f] = x.dims();
+        let mut states: Vec<Option<LstmCellState>> = vec![None; net.layers.len()];
+        for t in 0..m {
+            let mut inp = x.clone().slice([0..b, t..t + 1, 0..f]).reshape([b, f]);
+            for (layer, state) in net.layers.iter().zip(states.iter_mut()) {
+                let next = layer.forward_step(inp, state.take());
+                inp = next.hidden.clone();
+                *state = Some(next);
+            }
         }
-        let h = last.unwrap_or_else(|| {
-            let [_, m, f] = x.dims();
-            x.slice([0..b, m - 1..m, 0..f]).reshape([b, f])
-        });
+        let h = match states.pop().flatten() {
+            Some(s) => s.hidden,
+            // no layer or an empty window (both rejected by validation)
+            None => x
+                .slice([0..b, m.saturating_sub(1)..m, 0..f])
+                .reshape([b, f]),
+        };
         net.head.forward(h)
     }
 }
