@@ -8,10 +8,22 @@ use rand::rngs::SmallRng;
 use rand::{RngExt, SeedableRng};
 use std::hint::black_box;
 use std::time::Instant;
-fn cpu() -> f64 { std::fs::read_to_string("/proc/thread-self/schedstat").unwrap().split_whitespace().next().unwrap().parse::<f64>().unwrap() * 1e-9 }
+fn cpu() -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .unwrap()
+        .split_whitespace()
+        .next()
+        .unwrap()
+        .parse::<f64>()
+        .unwrap()
+        * 1e-9
+}
 use trajpred_particle::{Resampler, Resampling};
 fn main() {
-    if std::env::var("EXPT").is_ok() { exp_time(); return; }
+    if std::env::var("EXPT").is_ok() {
+        exp_time();
+        return;
+    }
     let args: Vec<String> = std::env::args().collect();
     let n: usize = args.get(1).map(|s| s.parse().unwrap()).unwrap_or(1_000_000);
     let reps: usize = args.get(2).map(|s| s.parse().unwrap()).unwrap_or(50);
@@ -22,20 +34,39 @@ fn main() {
     for _ in 0..3 {
         let t = Instant::now();
         let mut s = 0.0;
-        for _ in 0..reps { s += black_box(&weights).iter().sum::<f64>(); }
+        for _ in 0..reps {
+            s += black_box(&weights).iter().sum::<f64>();
+        }
         black_box(s);
         let dt = t.elapsed().as_secs_f64() / reps as f64;
-        eprintln!("sum {:8.2} ns/p {:8.1} M/s", dt * 1e9 / n as f64, n as f64 / dt / 1e6);
+        eprintln!(
+            "sum {:8.2} ns/p {:8.1} M/s",
+            dt * 1e9 / n as f64,
+            n as f64 / dt / 1e6
+        );
         let only = std::env::var("SCHEME").ok();
         for scheme in Resampling::ALL {
-            if only.as_deref().is_some_and(|o| o != scheme.name()) { continue; }
-            let t = Instant::now(); let c0 = cpu();
+            if only.as_deref().is_some_and(|o| o != scheme.name()) {
+                continue;
+            }
+            let t = Instant::now();
+            let c0 = cpu();
             for _ in 0..reps {
-                scheme.resample_into(black_box(&weights), &mut rng, &mut out).unwrap();
+                scheme
+                    .resample_into(black_box(&weights), &mut rng, &mut out)
+                    .unwrap();
                 black_box(&out);
             }
-            let dt = t.elapsed().as_secs_f64() / reps as f64; let dc = (cpu() - c0) / reps as f64;
-            eprintln!("{:12} {:8.2} ns/p {:8.1} M/s   cpu {:8.2} ns/p {:8.1} M/s", scheme.name(), dt * 1e9 / n as f64, n as f64 / dt / 1e6, dc * 1e9 / n as f64, n as f64 / dc / 1e6);
+            let dt = t.elapsed().as_secs_f64() / reps as f64;
+            let dc = (cpu() - c0) / reps as f64;
+            eprintln!(
+                "{:12} {:8.2} ns/p {:8.1} M/s   cpu {:8.2} ns/p {:8.1} M/s",
+                scheme.name(),
+                dt * 1e9 / n as f64,
+                n as f64 / dt / 1e6,
+                dc * 1e9 / n as f64,
+                n as f64 / dc / 1e6
+            );
         }
     }
 }
@@ -49,16 +80,30 @@ fn exp_time() {
         let c0 = cpu();
         for _ in 0..10 {
             let mut s = 0.0f64;
-            for b in buf.iter_mut() { let e: f64 = Exp1.sample(&mut rng); s += e; *b = s.to_bits(); }
+            for b in buf.iter_mut() {
+                let e: f64 = Exp1.sample(&mut rng);
+                s += e;
+                *b = s.to_bits();
+            }
             black_box(&buf);
         }
-        eprintln!("exp1 cpu {:.2} ns/draw", (cpu() - c0) / 10.0 / n as f64 * 1e9);
+        eprintln!(
+            "exp1 cpu {:.2} ns/draw",
+            (cpu() - c0) / 10.0 / n as f64 * 1e9
+        );
         let c0 = cpu();
         for _ in 0..10 {
             let mut s = 0.0f64;
-            for b in buf.iter_mut() { let e: f64 = rng.random(); s += e; *b = s.to_bits(); }
+            for b in buf.iter_mut() {
+                let e: f64 = rng.random();
+                s += e;
+                *b = s.to_bits();
+            }
             black_box(&buf);
         }
-        eprintln!("unif cpu {:.2} ns/draw", (cpu() - c0) / 10.0 / n as f64 * 1e9);
+        eprintln!(
+            "unif cpu {:.2} ns/draw",
+            (cpu() - c0) / 10.0 / n as f64 * 1e9
+        );
     }
 }
