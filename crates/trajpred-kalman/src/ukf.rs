@@ -144,6 +144,7 @@ impl<T: RealField + Copy> SigmaWeights<T> {
 
     /// `L` with `L L^T = (n + lambda) P` (lower Cholesky factor): its columns are the
     /// sigma-point offsets.
+    #[inline(always)]
     fn spread<D: Dim>(&self, p: &OMatrix<T, D, D>) -> Result<OMatrix<T, D, D>>
     where
         DefaultAllocator: Allocator<D, D>,
@@ -169,9 +170,10 @@ where
 /// `g(x) + sum_i Wi residual(g(x_i), g(x))` (equal to `sum_i Wm_i g(x_i)` for a linear
 /// residual, and a correct circular mean when `residual` wraps angles), the spread with
 /// `residual(g(x_i), mean)`.
+#[inline(always)]
 fn unscented_transform<T, D, E, R>(
     l: &OMatrix<T, D, D>,
-    images: SigmaImages<T, D, E>,
+    images: &SigmaImages<T, D, E>,
     w: &SigmaWeights<T>,
     residual: R,
     with_cross: bool,
@@ -203,13 +205,13 @@ where
     check_dim("transformed sigma points", n, minus.ncols())?;
     let mut sum = OVector::<T, E>::zeros_generic(e, nalgebra::Const::<1>);
     for j in 0..n {
-        sum += residual(&plus.column(j).into_owned(), &y0);
-        sum += residual(&minus.column(j).into_owned(), &y0);
+        sum += residual(&plus.column(j).into_owned(), y0);
+        sum += residual(&minus.column(j).into_owned(), y0);
     }
-    let mean = &y0 + sum * w.other;
+    let mean = y0 + sum * w.other;
     // the weighted spread: lower triangle accumulated column by column, then mirrored
     let mut covariance = OMatrix::<T, E, E>::zeros_generic(e, e);
-    let r0 = residual(&y0, &mean);
+    let r0 = residual(y0, &mean);
     for b in 0..ne {
         let wb = r0[b] * w.covariance0;
         for a in b..ne {
@@ -328,6 +330,7 @@ where
         + Allocator<D, M>
         + Allocator<M, D>,
 {
+    #[inline(always)]
     fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
         self.predict_transform(state, false).map(|(g, _)| g)
     }
@@ -337,6 +340,7 @@ where
         self.update_predicted(prior, z)
     }
 
+    #[inline(always)]
     fn update_predicted(
         &self,
         prior: &Gaussian<T, D>,
@@ -351,7 +355,7 @@ where
         let images = ob.observe_sigma_points(&prior.mean, &l)?;
         let t = unscented_transform(
             &l,
-            images,
+            &images,
             &self.weights,
             |a, b| ob.observation_residual(a, b),
             true,
@@ -411,6 +415,7 @@ where
 impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
     /// The prediction, and when `with_cross` the cross-covariance `Cov(x(k), x(k+1))` (the
     /// smoother's; zero otherwise, not computed).
+    #[inline(always)]
     fn predict_transform<D>(
         &self,
         filtered: &Gaussian<T, D>,
@@ -428,7 +433,7 @@ impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
         let images = tr.transition_sigma_points(&filtered.mean, &l)?;
         let t = unscented_transform(
             &l,
-            images,
+            &images,
             &self.weights,
             |a, b| tr.state_residual(a, b),
             with_cross,
