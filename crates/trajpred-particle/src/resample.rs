@@ -70,11 +70,34 @@ pub trait Resampler {
     fn name(&self) -> &'static str;
 }
 
-/// Validated weights: their sum and the index of the last positive weight.
+/// Validated weights: their sum, the index of the last positive weight, and the running sum
+/// at the midpoint (`mid`, a multiple of 4: the sum of `weights[..mid]`, accumulated in the
+/// same order as the total), where a parallel pass can start its second half exactly.
 #[derive(Debug, Clone, Copy)]
 struct Checked {
     total: f64,
     last: usize,
+    mid: usize,
+    mid_sum: f64,
+}
+
+/// The sequential sum of `weights` into `total` (four adds per step, in order) and whether
+/// any is negative.
+#[inline(always)]
+fn sum_and_sign(weights: &[f64], total: &mut f64, negative: &mut bool) {
+    let chunks = weights.chunks_exact(4);
+    let rest = chunks.remainder();
+    for q in chunks {
+        *total += q[0];
+        *total += q[1];
+        *total += q[2];
+        *total += q[3];
+        *negative |= (q[0] < 0.0) | (q[1] < 0.0) | (q[2] < 0.0) | (q[3] < 0.0);
+    }
+    for &v in rest {
+        *total += v;
+        *negative |= v < 0.0;
+    }
 }
 
 fn check_weights(weights: &[f64]) -> Result<Checked> {
@@ -84,21 +107,12 @@ fn check_weights(weights: &[f64]) -> Result<Checked> {
     // Fast pass: the sequential sum (the `C_(N-1)` the cumulative sums of the merge passes
     // end with) and a flag for negative weights; a NaN or infinite weight makes the sum
     // non-finite. Only on failure is the first offending weight looked for.
+    let mid = (weights.len() / 2) & !3;
     let mut total = 0.0f64;
     let mut negative = false;
-    let chunks = weights.chunks_exact(4);
-    let rest = chunks.remainder();
-    for q in chunks {
-        total += q[0];
-        total += q[1];
-        total += q[2];
-        total += q[3];
-        negative |= (q[0] < 0.0) | (q[1] < 0.0) | (q[2] < 0.0) | (q[3] < 0.0);
-    }
-    for &v in rest {
-        total += v;
-        negative |= v < 0.0;
-    }
+    sum_and_sign(&weights[..mid], &mut total, &mut negative);
+    let mid_sum = total;
+    sum_and_sign(&weights[mid..], &mut total, &mut negative);
     if negative || !total.is_finite() {
         for (index, &value) in weights.iter().enumerate() {
             if !(value.is_finite() && value >= 0.0) {
@@ -115,7 +129,12 @@ fn check_weights(weights: &[f64]) -> Result<Checked> {
     // non-negative weights with a zero sum are all zero
     let last = weights.iter().rposition(|&v| v > 0.0);
     match last {
-        Some(last) if total > 0.0 => Ok(Checked { total, last }),
+        Some(last) if total > 0.0 => Ok(Checked {
+            total,
+            last,
+            mid,
+            mid_sum,
+        }),
         _ => Err(ParticleError::AllWeightsZero {
             count: weights.len(),
         }),
@@ -209,6 +228,10 @@ fn ceil_near(h: f64, margin: f64) -> (usize, bool) {
     (r, d.abs() > 0.5 - margin)
 }
 
+/// Particles (and output slots) from which [`systematic_counts`] splits its pass in two
+/// halves run by `rayon::join`.
+const PARALLEL_MIN: usize = 1 << 17;
+
 /// Systematic resampling as counts per input particle, in one pass over the weights.
 ///
 /// The positions are `p_j = fl(fl(fl(j + u) / n) * W)` (the reference's operations, `W`
@@ -220,41 +243,105 @@ fn ceil_near(h: f64, margin: f64) -> (usize, bool) {
 /// positions. The indices are therefore exactly those of the merge `C_(i-1) <= p_j < C_i`,
 /// without its data-dependent branch per particle; the slots from `k_last` on (positions at
 /// or past `C_last`) take `last`.
+///
+/// From [`PARALLEL_MIN`] particles and slots on, the pass runs as two halves on the rayon
+/// pool: the second half starts from the running sum at the midpoint that
+/// [`check_weights`] kept (the same additions in the same order, so the same `C_i`) and
+/// from `k` of the particle before it (computed by the same exact rule), so the indices
+/// are identical to the one-pass result on any number of threads.
 fn systematic_counts(weights: &[f64], c: Checked, offset: f64, out: &mut [usize]) {
     let n = out.len();
     if n == 0 {
         return;
     }
-    let nf = n as f64;
-    let total = c.total;
-    let pos = |j: usize| (j as f64 + offset) / nf * total;
-    let scale = nf / total;
-    let margin = 16.0 * (nf + 2.0) * f64::EPSILON;
-    let half = 0.5 - offset;
-    // the fixed-width stores of the main loop need RUN slots from `start`
-    let lim = n.saturating_sub(RUN);
-    let mut start = 0usize;
-    let mut cum = 0.0f64;
-    for (i, &w) in weights[..=c.last].iter().enumerate() {
-        cum += w;
-        let (mut k, near) = ceil_near(cum * scale + half, margin);
+    let k = SystematicCount::new(n, c.total, offset);
+    let h = c.mid;
+    if h >= PARALLEL_MIN / 2 && h <= c.last && n >= PARALLEL_MIN && rayon::current_num_threads() > 1
+    {
+        let k_mid = k.count(c.mid_sum, 0);
+        let (first, second) = out.split_at_mut(k_mid);
+        rayon::join(
+            || k.run(&weights[..h], 0, 0.0, first),
+            || {
+                let end = k.run(&weights[h..=c.last], h, c.mid_sum, second);
+                second[end - k_mid..].fill(c.last);
+            },
+        );
+    } else {
+        let end = k.run(&weights[..=c.last], 0, 0.0, out);
+        out[end..].fill(c.last);
+    }
+}
+
+/// The count rule of [`systematic_counts`] for `n` slots, total `W` and offset `u`.
+#[derive(Debug, Clone, Copy)]
+struct SystematicCount {
+    n: usize,
+    total: f64,
+    offset: f64,
+    scale: f64,
+    half: f64,
+    margin: f64,
+}
+
+impl SystematicCount {
+    fn new(n: usize, total: f64, offset: f64) -> Self {
+        let nf = n as f64;
+        SystematicCount {
+            n,
+            total,
+            offset,
+            scale: nf / total,
+            half: 0.5 - offset,
+            margin: 16.0 * (nf + 2.0) * f64::EPSILON,
+        }
+    }
+
+    /// The position of slot `j`, in units of the weights.
+    #[inline(always)]
+    fn pos(&self, j: usize) -> f64 {
+        (j as f64 + self.offset) / self.n as f64 * self.total
+    }
+
+    /// `#{j : p_j < cum}`, knowing it is at least `start`.
+    #[inline(always)]
+    fn count(&self, cum: f64, start: usize) -> usize {
+        let n = self.n;
+        let (mut k, near) = ceil_near(cum * self.scale + self.half, self.margin);
         if near {
             k = (k as i64).clamp(start as i64, n as i64) as usize;
-            while k < n && pos(k) < cum {
+            while k < n && self.pos(k) < cum {
                 k += 1;
             }
-            while k > start && pos(k - 1) >= cum {
+            while k > start && self.pos(k - 1) >= cum {
                 k -= 1;
             }
         }
-        if k.wrapping_sub(start) <= RUN && start <= lim && n >= RUN {
-            out[start..start + RUN].fill(i);
-        } else {
-            out[start..k].fill(i);
-        }
-        start = k;
+        k
     }
-    out[start..].fill(c.last);
+
+    /// Writes the slots of the particles `first..first + weights.len()` (whose running sum
+    /// starts at `cum`) into `out`, which holds the slots from `k` of particle `first - 1`
+    /// (0 for the first particle) on; returns `k` of the last particle, in absolute slots.
+    #[inline(always)]
+    fn run(&self, weights: &[f64], first: usize, mut cum: f64, out: &mut [usize]) -> usize {
+        let base = if first == 0 { 0 } else { self.count(cum, 0) };
+        let len = out.len();
+        // the fixed-width stores of the main loop need RUN slots from `start`
+        let lim = len.saturating_sub(RUN);
+        let mut start = 0usize;
+        for (s, &w) in weights.iter().enumerate() {
+            cum += w;
+            let k = self.count(cum, start + base).saturating_sub(base).min(len);
+            if k.wrapping_sub(start) <= RUN && start <= lim && len >= RUN {
+                out[start..start + RUN].fill(first + s);
+            } else {
+                out[start..k].fill(first + s);
+            }
+            start = k;
+        }
+        start + base
+    }
 }
 
 /// Stratified resampling for given uniforms `u_j in [0, 1]` (one per output): positions

@@ -410,6 +410,60 @@ fn systematic_kernel_equals_the_plain_definition() {
     }
 }
 
+/// From 2^17 particles on the systematic pass runs as two halves on the rayon pool (the
+/// second starting from the running sum at the midpoint): on a 1-thread and a 2-thread pool
+/// the indices are identical, and equal to the plain definition, for ties (equal weights
+/// with `u = 0`), zeros, a dominant weight, a last positive weight before and just after
+/// the midpoint, and output sizes other than `N`.
+#[test]
+fn systematic_split_pass_equals_the_plain_definition_on_any_thread_count() {
+    use rand::RngExt;
+    let mut rng = ChaCha8Rng::seed_from_u64(78);
+    let below_one = f64::from_bits(1.0f64.to_bits() - 1);
+    let big = 300_001usize;
+    let mut shapes: Vec<Vec<f64>> = vec![
+        (0..big).map(|_| rng.random::<f64>()).collect(),
+        vec![1.0 / 3.0; big],
+    ];
+    let mut w: Vec<f64> = (0..big)
+        .map(|i| if i % 3 == 0 { 0.0 } else { rng.random() })
+        .collect();
+    w[big / 2 + 1] = 1.0e6;
+    shapes.push(w);
+    // last positive weight just before and just after the midpoint (150_000)
+    for last in [149_990usize, 150_003] {
+        shapes.push(
+            (0..big)
+                .map(|i| if i <= last { rng.random::<f64>() } else { 0.0 })
+                .collect(),
+        );
+    }
+    let pool = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool")
+    };
+    let (one, two) = (pool(1), pool(2));
+    for w in &shapes {
+        for &n_out in &[big, (1 << 17) + 3] {
+            for &u in &[0.0, below_one, rng.random::<f64>()] {
+                let run = |p: &rayon::ThreadPool| {
+                    let mut out = vec![usize::MAX; n_out];
+                    p.install(|| systematic_indices(w, u, &mut out))
+                        .expect("systematic");
+                    out
+                };
+                let (a, b) = (run(&one), run(&two));
+                let nf = n_out as f64;
+                let expected = reference_pick(w, (0..n_out).map(|j| (j as f64 + u) / nf));
+                assert!(a == expected, "1 thread, n {n_out} u {u}");
+                assert!(b == expected, "2 threads, n {n_out} u {u}");
+            }
+        }
+    }
+}
+
 /// Residual resampling's random remainder, drawn per block of particles (binomial block
 /// totals, then draws within each block), over several blocks: counts per particle as
 /// `copies + extra`, accumulated over `reps` seeded runs.
