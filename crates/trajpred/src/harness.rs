@@ -60,6 +60,12 @@ impl EvalConfig {
         if !(self.threshold.is_finite() && self.threshold > 0.0) {
             return bad("threshold", "must be finite and positive");
         }
+        if self.max_origins_per_trajectory == Some(0) {
+            return bad(
+                "max_origins_per_trajectory",
+                "must be at least 1 (None for every origin)",
+            );
+        }
         Ok(())
     }
 

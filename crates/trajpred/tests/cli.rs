@@ -133,6 +133,36 @@ fn evaluate_prints_a_table_for_every_method() {
         assert!(cells[2].parse::<usize>().unwrap() > 100, "{row}");
         assert_eq!(cells[3], "0", "{row}");
     }
+    // --max-origins caps the forecasts of every trajectory at that many
+    let capped = run(&[
+        "evaluate",
+        "--dataset",
+        "tdrive",
+        "--path",
+        tdir.to_str().unwrap(),
+        "--methods",
+        "poly1",
+        "--history",
+        "10",
+        "--horizon",
+        "3",
+        "--train-fraction",
+        "0.34",
+        "--max-origins",
+        "7",
+        "--format",
+        "csv",
+    ]);
+    assert!(capped.status.success());
+    let text = String::from_utf8(capped.stdout).unwrap();
+    let cells: Vec<&str> = text.lines().nth(1).unwrap().split(',').collect();
+    let trajectories: usize = cells[1].parse().unwrap();
+    assert!(trajectories >= 1, "{text}");
+    assert_eq!(
+        cells[2].parse::<usize>().unwrap(),
+        7 * trajectories,
+        "{text}"
+    );
 }
 
 #[test]

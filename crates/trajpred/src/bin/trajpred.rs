@@ -87,6 +87,10 @@ enum Command {
         /// Distance between origins.
         #[arg(long, default_value_t = 1)]
         stride: usize,
+        /// At most this many forecast origins per trajectory (the first ones; default: all).
+        /// Bounds the run time of slow methods (pf, mkpf) on large datasets.
+        #[arg(long)]
+        max_origins: Option<usize>,
         /// Resample every trajectory to this step (seconds) first.
         #[arg(long)]
         resample: Option<f64>,
@@ -279,6 +283,7 @@ fn run(cli: Cli) -> Result<()> {
             horizon,
             threshold,
             stride,
+            max_origins,
             resample,
             limit,
             train_fraction,
@@ -310,7 +315,7 @@ fn run(cli: Cli) -> Result<()> {
                 horizon,
                 stride,
                 threshold,
-                max_origins_per_trajectory: None,
+                max_origins_per_trajectory: max_origins,
             };
             let spinner =
                 ProgressBar::new_spinner().with_message(format!("loading {}", path.display()));
