@@ -41,7 +41,9 @@ impl Default for EvalConfig {
 }
 
 impl EvalConfig {
-    fn validate(&self) -> Result<()> {
+    /// Checks the settings (every count at least 1, a finite positive threshold); the
+    /// error names the first bad one. [`evaluate`] calls it before any forecast.
+    pub fn validate(&self) -> Result<()> {
         let bad = |name, reason: &str| {
             Err(Error::InvalidParameter {
                 name,

@@ -255,6 +255,19 @@ fn bad_input_gives_one_clear_line_and_a_failure_code() {
             ],
             ".svg or .png",
         ),
+        (
+            // checked before the data are loaded: the missing path is never reached
+            vec![
+                "evaluate",
+                "--dataset",
+                "csv",
+                "--path",
+                "/no/such/folder",
+                "--max-origins",
+                "0",
+            ],
+            "max_origins_per_trajectory",
+        ),
     ];
     for (args, needle) in cases {
         let out = run(&args);

@@ -317,6 +317,8 @@ fn run(cli: Cli) -> Result<()> {
                 threshold,
                 max_origins_per_trajectory: max_origins,
             };
+            // bad settings fail before the (possibly long) loading
+            cfg.validate()?;
             let spinner =
                 ProgressBar::new_spinner().with_message(format!("loading {}", path.display()));
             spinner.enable_steady_tick(std::time::Duration::from_millis(120));
