@@ -101,23 +101,29 @@ fn evaluate_prints_a_table_for_every_method() {
         taxi.replace("\n1,", "\n3,").replacen("1,", "3,", 1),
     )
     .unwrap();
-    let out = run(&[
-        "evaluate",
-        "--dataset",
-        "tdrive",
-        "--path",
-        tdir.to_str().unwrap(),
-        "--methods",
-        "kf-dynamic,poly2,hmm",
-        "--history",
-        "10",
-        "--horizon",
-        "3",
-        "--train-fraction",
-        "0.34",
-        "--format",
-        "csv",
-    ]);
+    // the same evaluation settings, with the methods and any extra options given
+    let evaluate = |methods: &str, extra: &[&str]| {
+        let mut args = vec![
+            "evaluate",
+            "--dataset",
+            "tdrive",
+            "--path",
+            tdir.to_str().unwrap(),
+            "--methods",
+            methods,
+            "--history",
+            "10",
+            "--horizon",
+            "3",
+            "--train-fraction",
+            "0.34",
+            "--format",
+            "csv",
+        ];
+        args.extend_from_slice(extra);
+        run(&args)
+    };
+    let out = evaluate("kf-dynamic,poly2,hmm", &[]);
     assert!(
         out.status.success(),
         "{}",
@@ -134,25 +140,7 @@ fn evaluate_prints_a_table_for_every_method() {
         assert_eq!(cells[3], "0", "{row}");
     }
     // --max-origins caps the forecasts of every trajectory at that many
-    let capped = run(&[
-        "evaluate",
-        "--dataset",
-        "tdrive",
-        "--path",
-        tdir.to_str().unwrap(),
-        "--methods",
-        "poly1",
-        "--history",
-        "10",
-        "--horizon",
-        "3",
-        "--train-fraction",
-        "0.34",
-        "--max-origins",
-        "7",
-        "--format",
-        "csv",
-    ]);
+    let capped = evaluate("poly1", &["--max-origins", "7"]);
     assert!(capped.status.success());
     let text = String::from_utf8(capped.stdout).unwrap();
     let cells: Vec<&str> = text.lines().nth(1).unwrap().split(',').collect();
