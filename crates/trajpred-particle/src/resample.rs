@@ -30,13 +30,18 @@
 //! particles: the block's number of draws is binomial given the draws left (the conditional
 //! law of a multinomial's block totals), and each draw is located in the block's cumulative
 //! residuals through a guide table (expected `O(1)` per draw); the copies and the drawn
-//! places are then written per particle in one streaming pass.
+//! places are then written per particle in one streaming pass. From `2^17` weights on, the
+//! residual scheme first cuts the particles into up to 16 parts (by their number alone),
+//! splits the remainder over the parts the same binomial way, seeds one generator per part
+//! from the caller's, and runs the parts in parallel: the indices are the same on any number
+//! of threads.
 //! The deterministic variants ([`systematic_indices`], [`stratified_indices`],
 //! [`multinomial_indices`], [`residual_indices`]) take the uniforms as input and follow the
 //! order of the given uniforms (the reference definitions used by the tests).
 
 use crate::error::{ParticleError, Result};
-use rand::{Rng, RngExt};
+use rand::rngs::Xoshiro256PlusPlus;
+use rand::{Rng, RngExt, SeedableRng};
 use rand_distr::{Distribution, Exp1};
 
 /// A resampling scheme: from weights, draw ancestor indices.
@@ -470,6 +475,18 @@ pub fn residual_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) ->
 /// the last positive residual or 0).
 #[inline]
 fn write_copies(weights: &[f64], scale: f64, out: &mut [usize]) -> (usize, f64, usize) {
+    write_copies_from(weights, 0, scale, out)
+}
+
+/// [`write_copies`] for the particles `first..first + weights.len()` (the indices written are
+/// offset by `first`; the returned last index is relative to `first`).
+#[inline]
+fn write_copies_from(
+    weights: &[f64],
+    first: usize,
+    scale: f64,
+    out: &mut [usize],
+) -> (usize, f64, usize) {
     let n = out.len();
     let mut k = 0usize;
     let mut s = 0.0f64;
@@ -483,7 +500,7 @@ fn write_copies(weights: &[f64], scale: f64, out: &mut [usize]) -> (usize, f64, 
         s += r;
         last = if r > 0.0 { i } else { last };
         let end = k.saturating_add(copies).min(n);
-        fill_run(out, k, end, i);
+        fill_run(out, k, end, first + i);
         k = end;
     }
     (k, s, last)
@@ -660,10 +677,11 @@ impl Resampler for Residual {
         rng: &mut R,
         out: &mut [usize],
     ) -> Result<()> {
-        let c = check_weights(weights)?;
         let n = out.len();
-        let scale = n as f64 / c.total;
-        let sums = residual_sums(weights, scale);
+        let mut parts = [Part::default(); PARTS_MAX];
+        let parts = &mut parts[..part_count(weights.len())];
+        let scale = n as f64 / residual_total(weights, parts)?;
+        let sums = residual_part_sums(weights, scale, parts);
         if sums.copies >= n {
             // no remainder (or, by rounding, copies for more than n places: clamped)
             write_copies(weights, scale, out);
@@ -681,7 +699,12 @@ impl Resampler for Residual {
             sorted_multinomial(rng, residual, weights.len(), s, last, &mut out[k..]);
             return Ok(());
         }
-        residual_blocks(weights, scale, sums, rng, out);
+        if let [_] = parts {
+            residual_blocks(weights, 0, scale, sums, rng, out);
+        } else {
+            split_draws(parts, (n - sums.copies) as u64, sums.residual, rng);
+            run_parts(weights, scale, parts, out);
+        }
         Ok(())
     }
     fn name(&self) -> &'static str {
@@ -700,7 +723,7 @@ const PROBE: usize = 4;
 /// (in four interleaved partial sums: its rounding differs from the blocks' sequential sums
 /// by a relative `O(N eps)`, which only moves the blocks' binomial probabilities by as
 /// much) and the index of the last positive residual.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 struct ResidualSums {
     copies: usize,
     residual: f64,
@@ -773,8 +796,11 @@ fn residual_sums(weights: &[f64], scale: f64) -> ResidualSums {
 /// Together that is exactly a multinomial draw of `m` places from `r_i / sum r` (up to
 /// the rounding of `S_b / S_left`, whose relative error is of order `eps S / S_left`).
 /// Then every particle's `floor(n w_i) + count_i` copies are written in index order.
+/// `weights` are the particles `first..first + weights.len()` (the indices written are
+/// offset by `first`; `sums` are theirs).
 fn residual_blocks<R: Rng + ?Sized>(
     weights: &[f64],
+    first: usize,
     scale: f64,
     sums: ResidualSums,
     rng: &mut R,
@@ -841,7 +867,7 @@ fn residual_blocks<R: Rng + ?Sized>(
                 &guide,
             );
         }
-        let base = b * BLOCK;
+        let base = first + b * BLOCK;
         for (s, &c) in count[..len].iter().enumerate() {
             let end = pos + c as usize;
             fill_run(out, pos, end, base + s);
@@ -849,6 +875,175 @@ fn residual_blocks<R: Rng + ?Sized>(
         }
     }
     debug_assert_eq!(pos, n);
+}
+
+/// Most parts of the residual pass; see [`part_count`].
+const PARTS_MAX: usize = 16;
+
+/// Fewest particles per part of the residual pass (a multiple of [`BLOCK`]).
+const PART_MIN: usize = 1 << 16;
+
+/// One part of the residual pass: the particles `start..end`, their weights' sum, their
+/// totals, the number of remainder draws that fall in them and the seed of their generator.
+#[derive(Debug, Clone, Copy, Default)]
+struct Part {
+    start: usize,
+    end: usize,
+    weight_sum: f64,
+    sums: ResidualSums,
+    draws: u64,
+    seed: [u8; 32],
+}
+
+impl Part {
+    /// Output slots of the part: its copies and its draws.
+    fn slots(&self) -> usize {
+        self.sums.copies + self.draws as usize
+    }
+}
+
+/// How many parts the residual pass splits `len` particles into: 1 below
+/// [`PARALLEL_MIN`], then one per [`PART_MIN`] particles, at most [`PARTS_MAX`]. It depends
+/// on `len` alone, never on the number of threads, so the draws do not either.
+fn part_count(len: usize) -> usize {
+    if len < PARALLEL_MIN {
+        1
+    } else {
+        (len / PART_MIN).clamp(2, PARTS_MAX)
+    }
+}
+
+/// Checks the weights and returns their sum `W`, after cutting `0..len` into
+/// `parts.len()` parts of equal size (a multiple of [`BLOCK`], the last one shorter).
+///
+/// One part: [`check_weights`] (the sequential sum). Several: each part's sum in four
+/// interleaved partial sums (in parallel), added in part order; a fixed order that depends
+/// on `len` alone, so `W` does not depend on the number of threads either. The residual
+/// scheme needs `W` only as the scale `n / W`, not as the end point of the running sums
+/// the merge schemes share. A negative, non-finite or all-zero input is reported by
+/// [`check_weights`].
+fn residual_total(weights: &[f64], parts: &mut [Part]) -> Result<f64> {
+    let len = weights.len();
+    if let [part] = parts {
+        part.end = len;
+        return Ok(check_weights(weights)?.total);
+    }
+    let size = len.div_ceil(parts.len()).div_ceil(BLOCK) * BLOCK;
+    for (j, part) in parts.iter_mut().enumerate() {
+        part.start = (j * size).min(len);
+        part.end = ((j + 1) * size).min(len);
+    }
+    use rayon::prelude::*;
+    parts.par_iter_mut().for_each(|p| {
+        let mut s = [0.0f64; 4];
+        let mut negative = false;
+        let chunks = weights[p.start..p.end].chunks_exact(4);
+        let rest = chunks.remainder();
+        for q in chunks {
+            for l in 0..4 {
+                s[l] += q[l];
+                negative |= q[l] < 0.0;
+            }
+        }
+        for &v in rest {
+            s[0] += v;
+            negative |= v < 0.0;
+        }
+        p.weight_sum = if negative {
+            f64::NAN
+        } else {
+            (s[0] + s[1]) + (s[2] + s[3])
+        };
+    });
+    let total: f64 = parts.iter().map(|p| p.weight_sum).sum();
+    if total.is_finite() && total > 0.0 {
+        Ok(total)
+    } else {
+        // the error, located (or, should only this order of additions overflow, the
+        // sequential sum)
+        Ok(check_weights(weights)?.total)
+    }
+}
+
+/// Fills in the parts' totals (in parallel when there are several; the parts cut by
+/// [`residual_total`]), returning the totals of all particles: copies and residual sum
+/// added in part order, `last` the last positive residual overall.
+fn residual_part_sums(weights: &[f64], scale: f64, parts: &mut [Part]) -> ResidualSums {
+    if let [part] = parts {
+        part.sums = residual_sums(weights, scale);
+        return part.sums;
+    }
+    use rayon::prelude::*;
+    parts
+        .par_iter_mut()
+        .for_each(|p| p.sums = residual_sums(&weights[p.start..p.end], scale));
+    let mut total = ResidualSums::default();
+    for p in parts.iter() {
+        total.copies += p.sums.copies;
+        total.residual += p.sums.residual;
+        if p.sums.residual > 0.0 {
+            total.last = p.start + p.sums.last;
+        }
+    }
+    total
+}
+
+/// Splits the `m` remainder draws over the parts as a multinomial's part totals, in part
+/// order: `M_j ~ Binomial(m_left, S_j / S_left)` (`S_j` the part's residual sum, `m_left`
+/// and `S_left` those of this part and the parts after it; the last part with a positive
+/// residual takes all `m_left`), then gives each part a seed drawn from `rng`.
+fn split_draws<R: Rng + ?Sized>(parts: &mut [Part], m: u64, residual: f64, rng: &mut R) {
+    let last = parts
+        .iter()
+        .rposition(|p| p.sums.residual > 0.0)
+        .unwrap_or(0);
+    let mut m_left = m;
+    let mut s_left = residual;
+    for (j, part) in parts.iter_mut().enumerate() {
+        let sj = part.sums.residual;
+        part.draws = if j >= last {
+            m_left
+        } else if m_left == 0 || sj <= 0.0 {
+            0
+        } else {
+            let p = (sj / s_left).min(1.0);
+            match rand_distr::Binomial::new(m_left, p) {
+                Ok(d) => d.sample(rng),
+                Err(_) => 0,
+            }
+        };
+        m_left -= part.draws;
+        s_left -= sj;
+    }
+    for part in parts.iter_mut() {
+        rng.fill_bytes(&mut part.seed);
+    }
+}
+
+/// Runs the parts into their consecutive output slots, halving the list under
+/// `rayon::join`: each part's draws come from its own generator (xoshiro256++ from its
+/// seed), so the indices are the same on any number of threads.
+fn run_parts(weights: &[f64], scale: f64, parts: &[Part], out: &mut [usize]) {
+    match parts {
+        [] => {}
+        [p] => {
+            let w = &weights[p.start..p.end];
+            if p.draws == 0 {
+                write_copies_from(w, p.start, scale, out);
+            } else {
+                let mut rng = Xoshiro256PlusPlus::from_seed(p.seed);
+                residual_blocks(w, p.start, scale, p.sums, &mut rng, out);
+            }
+        }
+        _ => {
+            let (left, right) = parts.split_at(parts.len() / 2);
+            let (a, b) = out.split_at_mut(left.iter().map(Part::slots).sum());
+            rayon::join(
+                || run_parts(weights, scale, left, a),
+                || run_parts(weights, scale, right, b),
+            );
+        }
+    }
 }
 
 /// The buckets of a guide table over one block: `of(x)`, `x inv` rounded to the nearest

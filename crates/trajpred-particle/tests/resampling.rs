@@ -617,3 +617,142 @@ fn residual_without_remainder_and_other_output_lengths() {
         );
     }
 }
+
+/// From 2^17 particles the residual scheme works in parts (by the input size alone), each
+/// drawing from its own generator seeded from the caller's: the indices are the same on 1,
+/// 2 and 3 threads, for random weights, zeros with a dominant weight, a part without any
+/// residual (all its draws then go elsewhere), positive weights in the first part only, and
+/// output sizes other than `N`; they come out sorted and never pick a zero weight.
+#[test]
+fn residual_parts_give_the_same_indices_on_any_thread_count() {
+    use rand::RngExt;
+    let mut rng = ChaCha8Rng::seed_from_u64(91);
+    let big = 300_001usize;
+    let mut shapes: Vec<Vec<f64>> = vec![(0..big).map(|_| rng.random::<f64>()).collect()];
+    let mut w: Vec<f64> = (0..big)
+        .map(|i| if i % 3 == 0 { 0.0 } else { rng.random() })
+        .collect();
+    w[big / 2 + 1] = 1.0e6;
+    shapes.push(w);
+    // equal weights (no residual for n = N) over the second quarter, random elsewhere
+    shapes.push(
+        (0..big)
+            .map(|i| {
+                if (big / 4..big / 2).contains(&i) {
+                    0.5
+                } else {
+                    rng.random()
+                }
+            })
+            .collect(),
+    );
+    shapes.push(
+        (0..big)
+            .map(|i| if i < 40_000 { rng.random::<f64>() } else { 0.0 })
+            .collect(),
+    );
+    let pool = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool")
+    };
+    let pools = [pool(1), pool(2), pool(3)];
+    for (k, w) in shapes.iter().enumerate() {
+        for &n_out in &[big, (1 << 17) + 3, 2 * big] {
+            for seed in [5u64, 6] {
+                let run = |p: &rayon::ThreadPool| {
+                    let mut out = vec![usize::MAX; n_out];
+                    p.install(|| {
+                        Residual.resample_into(w, &mut ChaCha8Rng::seed_from_u64(seed), &mut out)
+                    })
+                    .expect("residual");
+                    out
+                };
+                let first = run(&pools[0]);
+                assert!(first.windows(2).all(|p| p[0] <= p[1]), "sorted, shape {k}");
+                assert!(first.iter().all(|&i| w[i] > 0.0), "zero weight, shape {k}");
+                for (t, p) in pools.iter().enumerate().skip(1) {
+                    assert!(run(p) == first, "{} threads, shape {k}, n {n_out}", t + 1);
+                }
+            }
+        }
+    }
+}
+
+/// The remainder over several parts is still one multinomial draw: `N = 2^18` particles
+/// (four parts) whose quarters carry residual mass 0, `N/16`, `N/8` and `N/16` (`n / W = 2`,
+/// so every `n w_i` is exact), `m = N/4` draws. Over 200 seeded runs the extra copies in
+/// each eighth of the particles have mean `m p` within 5 standard errors and variance
+/// `m p (1 - p)` within 25 % (a split of the draws by fixed proportions would leave only
+/// the within-part variance), and particles without residual never gain a copy.
+#[test]
+fn residual_remainder_over_parts_is_multinomial() {
+    let len = 1usize << 18;
+    let quarter = len / 4;
+    // per group of 4 (sum 2, n w = 2 x): residuals 0, 1, 2 and 1 per group
+    let groups: [[f64; 4]; 4] = [
+        [0.5, 0.5, 0.5, 0.5],
+        [0.25, 0.25, 0.5, 1.0],
+        [0.25, 0.75, 0.25, 0.75],
+        [0.125, 0.125, 0.75, 1.0],
+    ];
+    let w: Vec<f64> = (0..len).map(|i| groups[i / quarter][i % 4]).collect();
+    let scale = 2.0;
+    assert_eq!(len as f64 / w.iter().sum::<f64>(), scale);
+    let floors: Vec<usize> = w.iter().map(|&x| (x * scale).floor() as usize).collect();
+    let resid: Vec<f64> = w.iter().map(|&x| x * scale - (x * scale).floor()).collect();
+    let m = len - floors.iter().sum::<usize>();
+    assert_eq!(m, len / 4);
+    let ranges = 8;
+    let width = len / ranges;
+    let p: Vec<f64> = (0..ranges)
+        .map(|r| resid[r * width..(r + 1) * width].iter().sum::<f64>() / m as f64)
+        .collect();
+    let reps = 200;
+    let mut rng = ChaCha8Rng::seed_from_u64(17);
+    let mut out = vec![0usize; len];
+    let mut count = vec![0usize; len];
+    let (mut sum, mut sum2) = (vec![0.0f64; ranges], vec![0.0f64; ranges]);
+    for _ in 0..reps {
+        Residual
+            .resample_into(&w, &mut rng, &mut out)
+            .expect("residual");
+        count.fill(0);
+        for &i in &out {
+            count[i] += 1;
+        }
+        let mut extra = vec![0.0f64; ranges];
+        for i in 0..len {
+            assert!(count[i] >= floors[i], "particle {i} lost a copy");
+            let e = count[i] - floors[i];
+            assert!(
+                e == 0 || resid[i] > 0.0,
+                "particle {i} without residual drawn"
+            );
+            extra[i / width] += e as f64;
+        }
+        for r in 0..ranges {
+            sum[r] += extra[r];
+            sum2[r] += extra[r] * extra[r];
+        }
+    }
+    let n = reps as f64;
+    for r in 0..ranges {
+        let mean = sum[r] / n;
+        let var = (sum2[r] / n - mean * mean) * n / (n - 1.0);
+        let (e, v) = (m as f64 * p[r], m as f64 * p[r] * (1.0 - p[r]));
+        if p[r] == 0.0 {
+            assert_eq!((mean, var), (0.0, 0.0), "range {r}");
+            continue;
+        }
+        assert!(
+            (mean - e).abs() < 5.0 * (v / n).sqrt(),
+            "range {r}: mean {mean}, expected {e}"
+        );
+        assert!(
+            (var / v - 1.0).abs() < 0.25,
+            "range {r}: variance {var}, expected {v}"
+        );
+    }
+}
