@@ -263,3 +263,20 @@ pub(crate) fn check_finite(what: &'static str, values: &[f64]) -> Result<()> {
         None => Ok(()),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A loss read back from an empty tensor is a typed error, not a panic or a NaN.
+    #[test]
+    fn reading_an_empty_loss_is_a_tensor_error() {
+        let empty = Tensor::<1>::from_data(TensorData::new(Vec::<f32>::new(), [0]), &device());
+        assert!(matches!(
+            read_scalar(empty),
+            Err(NeuralError::Tensor { reason }) if reason == "empty loss tensor"
+        ));
+        let one = Tensor::<1>::from_data(TensorData::new(vec![2.5f32], [1]), &device());
+        assert_eq!(read_scalar(one).expect("one value"), 2.5);
+    }
+}

@@ -11,8 +11,8 @@ use trajpred_kalman::motion::{
     KinematicLayout, StateOrder, constant_velocity, position_observation,
 };
 use trajpred_kalman::{
-    CoordinatedTurn, Filter, Kf, LinearObservation, LinearTransition, MerweSigmaPoints,
-    Observation, RangeBearing, Transition, Ukf,
+    CoordinatedTurn, Filter, KalmanError, Kf, LinearObservation, LinearTransition,
+    MerweSigmaPoints, Observation, RangeBearing, Transition, Ukf,
 };
 use trajpred_particle::{
     EkfStage, Mkpf, ParticleCloud, ParticleError, ParticleFilter, ParticleFiltering, ParticlePrior,
@@ -478,6 +478,26 @@ fn degenerate_inputs_are_typed_errors_or_documented_recoveries() {
         .err(),
         Some(ParticleError::NotPositiveDefinite { what: "Q" })
     );
+    // sigma-point parameters with n + lambda = alpha^2 (n + kappa) = 0: the Kalman crate's
+    // typed error, passed through
+    let (tr, _) = linear_model();
+    let ob1 = LinearObservation::new(Matrix1x2::new(1.0, 0.0), Matrix1::new(1.0)).expect("ob");
+    let tr_pd = LinearTransition::new(*tr.f(), Matrix2::identity()).expect("tr");
+    assert!(matches!(
+        Mkpf::<f64, U2, U1, _, _>::from_gaussian(
+            tr_pd,
+            ob1,
+            &x0,
+            10,
+            MerweSigmaPoints::new(1.0, 2.0, -2.0),
+            &mut rng
+        )
+        .err(),
+        Some(ParticleError::Kalman(KalmanError::DegenerateSigmaPoints {
+            n: 2,
+            ..
+        }))
+    ));
 }
 
 #[test]
