@@ -9,7 +9,7 @@ use crate::error::{NeuralError, Result};
 use burn::module::Module;
 use burn::nn::{Linear, LinearConfig, Rnn, RnnConfig};
 use burn::tensor::activation::{relu, sigmoid, tanh};
-use burn::tensor::{Device, Tensor};
+use burn::tensor::{Device, Tensor, TensorData};
 use serde::{Deserialize, Serialize, de::DeserializeOwned};
 use std::fmt::Debug;
 
@@ -186,8 +186,8 @@ pub struct LstmStack {
 /// `c' = sigmoid(f) c + sigmoid(i) tanh(g)`, `h' = sigmoid(o) tanh(c')`.
 ///
 /// The same equations as burn's `nn::Lstm`, with fewer tensor operations per step (two
-/// matrix products instead of eight, and the input product of a whole sequence computed at
-/// once), which is what a CPU step costs here.
+/// matrix products instead of eight, one sigmoid for the four gates, `tanh` through
+/// sigmoid), which is what a CPU step costs here.
 #[derive(Module, Debug)]
 pub struct FusedLstm {
     input: Linear,
@@ -216,32 +216,66 @@ impl FusedLstm {
         }
     }
 
+    /// The constant `[1, 4 hidden]` row that doubles the cell block of the gates: one
+    /// sigmoid of the scaled gates then gives the three gates and `tanh(g) = 2 sigmoid(2 g)
+    /// - 1` at once.
+    fn gate_scale(&self, device: &Device) -> Tensor<2> {
+        let h = self.d_hidden;
+        let row: Vec<f32> = (0..4 * h)
+            .map(|j| {
+                if (2 * h..3 * h).contains(&j) {
+                    2.0
+                } else {
+                    1.0
+                }
+            })
+            .collect();
+        Tensor::from_data(TensorData::new(row, [1, 4 * h]), device)
+    }
+
     /// One step from the input projection `xw = x W_ih + b` (`[batch, 4 hidden]`).
     ///
-    /// One sigmoid over all four gate blocks (the cell block's sigmoid is not used) instead
-    /// of one per gate: on the CPU backend an operation costs mostly its fixed overhead, and
-    /// burn's autodiff recomputes a sigmoid in the backward pass.
-    fn step(&self, xw: Tensor<2>, state: Option<LstmCellState>) -> LstmCellState {
+    /// One sigmoid over all four gate blocks, the cell block doubled first (`scale`, from
+    /// [`FusedLstm::gate_scale`]) so that its sigmoid gives `tanh(g) = 2 sigmoid(2 g) - 1`;
+    /// `tanh(c')` is taken the same way. The same equations: on the CPU backend `tanh` is
+    /// the C library's `tanhf`, several times the cost of sigmoid's one `exp` per element,
+    /// burn's autodiff evaluates both again in the backward pass, and an operation costs
+    /// mostly its fixed overhead (the one extra product here replaces a `tanh` and its
+    /// backward).
+    fn step(
+        &self,
+        xw: Tensor<2>,
+        state: Option<LstmCellState>,
+        scale: &Tensor<2>,
+    ) -> LstmCellState {
         let gates = match &state {
             Some(s) => xw + self.recurrent.forward(s.hidden.clone()),
             None => xw,
         };
         let h = self.d_hidden;
-        let act = sigmoid(gates.clone());
+        let act = sigmoid(gates * scale.clone());
         let i = act.clone().narrow(1, 0, h);
         let o = act.clone().narrow(1, 3 * h, h);
-        let ic = i * tanh(gates.narrow(1, 2 * h, h));
+        let g = act
+            .clone()
+            .narrow(1, 2 * h, h)
+            .mul_scalar(2.0)
+            .sub_scalar(1.0);
+        let ic = i * g;
         let cell = match state {
             Some(s) => act.narrow(1, h, h) * s.cell + ic,
             None => ic,
         };
-        let hidden = o * tanh(cell.clone());
+        let hidden = o * sigmoid(cell.clone().mul_scalar(2.0))
+            .mul_scalar(2.0)
+            .sub_scalar(1.0);
         LstmCellState { cell, hidden }
     }
 
     /// One step on input `x: [batch, d_input]`.
     pub fn forward_step(&self, x: Tensor<2>, state: Option<LstmCellState>) -> LstmCellState {
-        self.step(self.input.forward(x), state)
+        let scale = self.gate_scale(&x.device());
+        self.step(self.input.forward(x), state, &scale)
     }
 
     /// Runs over `x: [batch, steps, d_input]`; returns every hidden state
@@ -258,9 +292,10 @@ impl FusedLstm {
         let [b, m, d] = x.dims();
         let mut state = state;
         let mut outs = Vec::with_capacity(m);
+        let scale = self.gate_scale(&x.device());
         for t in 0..m {
             let xt = x.clone().slice([0..b, t..t + 1, 0..d]).reshape([b, d]);
-            let s = self.forward_step(xt, state);
+            let s = self.step(self.input.forward(xt), state, &scale);
             outs.push(s.hidden.clone());
             state = Some(s);
         }
@@ -335,10 +370,15 @@ impl Architecture for LstmArch {
     fn forward(&self, net: &LstmStack, x: Tensor<3>) -> Tensor<2> {
         let [b, m, f] = x.dims();
         let mut states: Vec<Option<LstmCellState>> = vec![None; net.layers.len()];
+        let scales: Vec<Tensor<2>> = net
+            .layers
+            .iter()
+            .map(|l| l.gate_scale(&x.device()))
+            .collect();
         for t in 0..m {
             let mut inp = x.clone().slice([0..b, t..t + 1, 0..f]).reshape([b, f]);
-            for (layer, state) in net.layers.iter().zip(states.iter_mut()) {
-                let next = layer.forward_step(inp, state.take());
+            for ((layer, state), scale) in net.layers.iter().zip(states.iter_mut()).zip(&scales) {
+                let next = layer.step(layer.input.forward(inp), state.take(), scale);
                 inp = next.hidden.clone();
                 *state = Some(next);
             }
