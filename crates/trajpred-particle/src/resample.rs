@@ -777,6 +777,24 @@ fn residual_sums(weights: &[f64], scale: f64) -> ResidualSums {
     }
 }
 
+/// The draws of one group (a block, or a part) out of the `m_left` draws left, whose
+/// residual sum is `s` of the `s_left` left: all of them for the group of the last positive
+/// residual (`last`), else `Binomial(m_left, s / s_left)`, the conditional law of a
+/// multinomial's group totals.
+#[inline]
+fn share<R: Rng + ?Sized>(last: bool, m_left: u64, s: f64, s_left: f64, rng: &mut R) -> u64 {
+    if last {
+        m_left
+    } else if m_left == 0 || s <= 0.0 {
+        0
+    } else {
+        match rand_distr::Binomial::new(m_left, (s / s_left).min(1.0)) {
+            Ok(d) => d.sample(rng),
+            Err(_) => 0,
+        }
+    }
+}
+
 /// Residual resampling with the remainder drawn block by block, the output written in one
 /// streaming pass, sorted by particle.
 ///
@@ -831,17 +849,7 @@ fn residual_blocks<R: Rng + ?Sized>(
             start = g.extend(&mut guide, start, g.of(sb) + 1, s);
         }
         cum[len..len + PROBE].fill(f64::INFINITY);
-        let draws = if b >= last_block {
-            m_left
-        } else if m_left == 0 || sb <= 0.0 {
-            0
-        } else {
-            let p = (sb / s_left).min(1.0);
-            match rand_distr::Binomial::new(m_left, p) {
-                Ok(d) => d.sample(rng),
-                Err(_) => 0,
-            }
-        };
+        let draws = share(b >= last_block, m_left, sb, s_left, rng);
         m_left -= draws;
         s_left -= sb;
         if draws > 0 {
@@ -1001,17 +1009,7 @@ fn split_draws<R: Rng + ?Sized>(parts: &mut [Part], m: u64, residual: f64, rng: 
     let mut s_left = residual;
     for (j, part) in parts.iter_mut().enumerate() {
         let sj = part.sums.residual;
-        part.draws = if j >= last {
-            m_left
-        } else if m_left == 0 || sj <= 0.0 {
-            0
-        } else {
-            let p = (sj / s_left).min(1.0);
-            match rand_distr::Binomial::new(m_left, p) {
-                Ok(d) => d.sample(rng),
-                Err(_) => 0,
-            }
-        };
+        part.draws = share(j >= last, m_left, sj, s_left, rng);
         m_left -= part.draws;
         s_left -= sj;
     }

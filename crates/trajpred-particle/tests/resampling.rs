@@ -438,12 +438,6 @@ fn systematic_split_pass_equals_the_plain_definition_on_any_thread_count() {
                 .collect(),
         );
     }
-    let pool = |threads| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("pool")
-    };
     let (one, two) = (pool(1), pool(2));
     for w in &shapes {
         for &n_out in &[big, (1 << 17) + 3] {
@@ -462,6 +456,14 @@ fn systematic_split_pass_equals_the_plain_definition_on_any_thread_count() {
             }
         }
     }
+}
+
+/// A rayon pool of `threads` threads, to run a resampler on a given thread count.
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("pool")
 }
 
 /// Residual resampling's random remainder, drawn per block of particles (binomial block
@@ -651,12 +653,6 @@ fn residual_parts_give_the_same_indices_on_any_thread_count() {
             .map(|i| if i < 40_000 { rng.random::<f64>() } else { 0.0 })
             .collect(),
     );
-    let pool = |threads| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("pool")
-    };
     let pools = [pool(1), pool(2), pool(3)];
     for (k, w) in shapes.iter().enumerate() {
         for &n_out in &[big, (1 << 17) + 3, 2 * big] {
