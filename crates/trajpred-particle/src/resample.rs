@@ -28,13 +28,14 @@
 //! variates (the order statistics of uniforms), so the selection is one merge pass instead
 //! of a binary search per draw. The residual scheme draws its remainder per block of
 //! particles: the block's number of draws is binomial given the draws left (the conditional
-//! law of a multinomial's block totals), and each draw is located in the block's cumulative
-//! residuals through a guide table (expected `O(1)` per draw); the copies and the drawn
-//! places are then written per particle in one streaming pass. From `2^17` weights on, the
-//! residual scheme first cuts the particles into up to 16 parts (by their number alone),
-//! splits the remainder over the parts the same binomial way, seeds one generator per part
-//! from the caller's, and runs the parts in parallel: the indices are the same on any number
-//! of threads.
+//! law of a multinomial's block totals), and each draw is a slot of the block accepted with
+//! probability its residual (rejection from one 64-bit draw per try, about one try per
+//! particle; blocks whose residual is concentrated on few particles search their cumulative
+//! residuals instead); the copies and the drawn places are then written per particle in one
+//! streaming pass. From `2^17` weights on, the residual scheme first cuts the particles into
+//! up to 16 parts (by their number alone), splits the remainder over the parts the same
+//! binomial way, seeds one generator per part from the caller's, and runs the parts in
+//! parallel: the indices are the same on any number of threads.
 //! The deterministic variants ([`systematic_indices`], [`stratified_indices`],
 //! [`multinomial_indices`], [`residual_indices`]) take the uniforms as input and follow the
 //! order of the given uniforms (the reference definitions used by the tests).
@@ -712,12 +713,12 @@ impl Resampler for Residual {
     }
 }
 
-/// Particles per block of [`residual_blocks`] (its per-block arrays live on the stack and
-/// stay in the first-level cache).
+/// Particles per block of [`residual_blocks`] (its two per-block arrays, 24 KiB, live on
+/// the stack and stay in the first-level cache). A power of two.
 const BLOCK: usize = 2048;
 
-/// Slots of the cumulative residuals read per draw of [`residual_blocks`] without a branch.
-const PROBE: usize = 4;
+/// Lowest acceptance for which [`residual_blocks`] draws a block's remainder by rejection.
+const ACCEPT_MIN: f64 = 0.25;
 
 /// Totals of the residual scheme: the copies `sum_i floor(w_i scale)`, the residual sum
 /// (in four interleaved partial sums: its rounding differs from the blocks' sequential sums
@@ -799,23 +800,30 @@ fn share<R: Rng + ?Sized>(last: bool, m_left: u64, s: f64, s_left: f64, rng: &mu
 /// streaming pass, sorted by particle.
 ///
 /// Requires `sums.copies < out.len() <= u32::MAX` and `sums.residual > 0`. With `m = n - copies`
-/// remainder draws from the residuals `r_i`, the multinomial counts are drawn as
+/// remainder draws from the residuals `r_i in [0, 1)`, the multinomial counts are drawn as
 /// 1. per block `b` of [`BLOCK`] particles (residual sum `S_b`), in order: the block's
 ///    number of draws `M_b ~ Binomial(m_left, S_b / S_left)` (`m_left`, `S_left`: the draws
 ///    and the residual sum of this block and the blocks after it; the block holding the
 ///    last positive residual takes all `m_left`), which is the conditional law of a
 ///    multinomial's block totals;
-/// 2. within the block, `M_b` i.i.d. draws `u ~ U[0, S_b)` located in the block's cumulative
-///    residuals by a guide table (Chen's index table: `g[t]` = the first particle whose
-///    cumulative residual reaches bucket `t` of `[0, S_b)`, so the particle of `u` is at or
-///    after `g[bucket(u)]`; [`PROBE`] slots from there are compared without a branch, a rare
-///    longer walk falls back to a loop), each draw adding one to the particle's count.
+/// 2. within the block, `M_b` i.i.d. draws from `r_s / S_b`. By rejection when the
+///    acceptance `S_b / 2^k` is at least [`ACCEPT_MIN`] (`2^k >= len` the block's slots,
+///    those past its particles holding residual 0): one 64-bit draw gives a slot `t` (its
+///    top `k` bits) and `v in [0, 1)` (its low 53 bits), accepted when `v < r_t`, so each try
+///    accepts slot `t` with probability `r_t / 2^k` and an accepted slot is distributed as
+///    `r_t / S_b`. Tries are repeated until `M_b` are accepted: on average at most
+///    `1 / ACCEPT_MIN` per draw, and since `E[M_b] = S_b` up to rounding (the residuals sum
+///    to `m`), about `2^k` per block however the residuals are spread: no cumulative sums,
+///    no table, no search. Below that acceptance (few particles carry the block's residual,
+///    and it has few draws), each draw `u ~ U[0, S_b)` is located in the block's cumulative
+///    residuals by binary search.
 ///
-/// Together that is exactly a multinomial draw of `m` places from `r_i / sum r` (up to
-/// the rounding of `S_b / S_left`, whose relative error is of order `eps S / S_left`).
-/// Then every particle's `floor(n w_i) + count_i` copies are written in index order.
-/// `weights` are the particles `first..first + weights.len()` (the indices written are
-/// offset by `first`; `sums` are theirs).
+/// Together that is exactly a multinomial draw of `m` places from `r_i / sum r`, up to the
+/// rounding of `S_b / S_left` (a relative error of order `eps S / S_left`) and the `2^-53`
+/// granularity of `v` and `u` (as in any sampler fed 53-bit uniforms). Then every
+/// particle's `floor(n w_i) + count_i` copies are written in index order. `weights` are the
+/// particles `first..first + weights.len()` (the indices written are offset by `first`;
+/// `sums` are theirs).
 fn residual_blocks<R: Rng + ?Sized>(
     weights: &[f64],
     first: usize,
@@ -828,52 +836,24 @@ fn residual_blocks<R: Rng + ?Sized>(
     let mut m_left = (n - sums.copies) as u64;
     let mut s_left = sums.residual;
     let last_block = sums.last / BLOCK;
-    let mut cum = [0.0f64; BLOCK + PROBE];
+    let mut resid = [0.0f64; BLOCK];
     let mut count = [0u32; BLOCK];
-    let mut guide = [0u16; 2 * BLOCK + 1 + RUN];
     let mut pos = 0usize;
     for (b, chunk) in weights.chunks(BLOCK).enumerate() {
         let len = chunk.len();
-        // The guide table is built in the same pass, on buckets of the block's expected
-        // residual sum (the average over the blocks left); rebuilt below on the actual sum
-        // if that is off by more than a factor of 2.
-        let expected = s_left * len as f64 / (weights.len() - b * BLOCK) as f64;
-        let mut g = Buckets::new(len, expected);
-        let mut start = 0usize;
-        let mut sb = 0.0f64;
-        for (s, &w) in chunk.iter().enumerate() {
-            let (f, r) = split(w, scale);
-            sb += r;
-            cum[s] = sb;
-            count[s] = f as u32;
-            start = g.extend(&mut guide, start, g.of(sb) + 1, s);
-        }
-        cum[len..len + PROBE].fill(f64::INFINITY);
+        let sb = block_residuals(chunk, scale, &mut resid[..len], &mut count[..len]);
         let draws = share(b >= last_block, m_left, sb, s_left, rng);
         m_left -= draws;
         s_left -= sb;
         if draws > 0 {
-            let t = sb * g.inv;
-            if !(t >= 0.5 * len as f64 && t <= 2.0 * len as f64) {
-                g = Buckets::new(len, sb);
-                let mut start = 0usize;
-                for (s, &c) in cum[..len].iter().enumerate() {
-                    start = g.extend(&mut guide, start, g.of(c) + 1, s);
-                }
+            // k >= 1 bits of slot, so that a one-particle block has a zero slot too
+            let k = (usize::BITS - (len - 1).leading_zeros()).max(1);
+            resid[len..1 << k].fill(0.0);
+            if sb >= ACCEPT_MIN * (1u64 << k) as f64 {
+                draw_by_rejection(&resid, k, draws, rng, &mut count);
+            } else {
+                draw_by_search(&resid[..len], draws, rng, &mut count[..len]);
             }
-            // the first particle whose cumulative residual reaches the block's sum: the
-            // last one that can be selected (later ones add nothing)
-            let lb = cum[..len].partition_point(|&c| c < sb);
-            draw_in_block(
-                &cum[..len + PROBE],
-                sb,
-                lb,
-                g,
-                draws,
-                rng,
-                &mut count[..len],
-                &guide,
-            );
         }
         let base = first + b * BLOCK;
         for (s, &c) in count[..len].iter().enumerate() {
@@ -883,6 +863,80 @@ fn residual_blocks<R: Rng + ?Sized>(
         }
     }
     debug_assert_eq!(pos, n);
+}
+
+/// Splits one block's `w_i scale` into copies (`count`) and residuals (`resid`), returning
+/// the residual sum (in four interleaved partial sums, like [`residual_sums`]).
+#[inline(always)]
+fn block_residuals(chunk: &[f64], scale: f64, resid: &mut [f64], count: &mut [u32]) -> f64 {
+    let len = chunk.len();
+    let body = len - len % 4;
+    let mut acc = [0.0f64; 4];
+    for ((q, rq), cq) in chunk[..body]
+        .chunks_exact(4)
+        .zip(resid[..body].chunks_exact_mut(4))
+        .zip(count[..body].chunks_exact_mut(4))
+    {
+        for l in 0..4 {
+            let (f, x) = split(q[l], scale);
+            rq[l] = x;
+            cq[l] = f as u32;
+            acc[l] += x;
+        }
+    }
+    for s in body..len {
+        let (f, x) = split(chunk[s], scale);
+        resid[s] = x;
+        count[s] = f as u32;
+        acc[0] += x;
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3])
+}
+
+/// `draws` i.i.d. draws from the residuals `resid[..2^k]` (each in `[0, 1)`; `1 <= k <=
+/// log2 BLOCK`), by rejection, each adding one to `count` of its slot; see
+/// [`residual_blocks`]. Branch-free per try.
+#[inline]
+fn draw_by_rejection<R: Rng + ?Sized>(
+    resid: &[f64; BLOCK],
+    k: u32,
+    draws: u64,
+    rng: &mut R,
+    count: &mut [u32; BLOCK],
+) {
+    let shift = 64 - k;
+    let low = (1u64 << 53) - 1;
+    let unit = 1.0 / (1u64 << 53) as f64;
+    let mut placed = 0u64;
+    while placed < draws {
+        let x = rng.next_u64();
+        let t = (x >> shift) as usize & (BLOCK - 1);
+        // below 2^53: the signed conversion (one instruction) is exact
+        let v = (x & low) as i64 as f64 * unit;
+        let hit = u32::from(v < resid[t]);
+        count[t] += hit;
+        placed += u64::from(hit);
+    }
+}
+
+/// `draws` i.i.d. draws from the residuals `resid` (positive sum), each located in their
+/// cumulative sums by binary search and adding one to `count` of its particle; a draw that
+/// rounding puts at or past the total selects the last positive residual.
+fn draw_by_search<R: Rng + ?Sized>(resid: &[f64], draws: u64, rng: &mut R, count: &mut [u32]) {
+    let mut cum = [0.0f64; BLOCK];
+    let cum = &mut cum[..resid.len()];
+    let mut c = 0.0f64;
+    for (d, &r) in cum.iter_mut().zip(resid) {
+        c += r;
+        *d = c;
+    }
+    let last = resid.iter().rposition(|&r| r > 0.0).unwrap_or(0);
+    let unit = c * (1.0 / (1u64 << 53) as f64);
+    for _ in 0..draws {
+        let u = (rng.next_u64() >> 11) as f64 * unit;
+        let s = cum.partition_point(|&c| c <= u);
+        count[s.min(last)] += 1;
+    }
 }
 
 /// Most parts of the residual pass; see [`part_count`].
@@ -1041,80 +1095,6 @@ fn run_parts(weights: &[f64], scale: f64, parts: &[Part], out: &mut [usize]) {
                 || run_parts(weights, scale, right, b),
             );
         }
-    }
-}
-
-/// The buckets of a guide table over one block: `of(x)`, `x inv` rounded to the nearest
-/// integer (through the bits of `x inv + ROUND`: no conversion instruction) and clamped to
-/// `max = 2 len`; any non-decreasing map of `x` serves. The guide `g[t] = min { s :
-/// of(cum[s]) >= t }` is then a lower bound of the particle of every `u` in bucket `t`
-/// (`cum[s-1] <= u < cum[s]` gives `of(u) <= of(cum[s])`).
-#[derive(Debug, Clone, Copy)]
-struct Buckets {
-    inv: f64,
-    max: usize,
-}
-
-impl Buckets {
-    /// About `len` buckets over `[0, total)`.
-    fn new(len: usize, total: f64) -> Self {
-        let inv = len as f64 / total;
-        Buckets {
-            inv: if inv.is_finite() { inv } else { 0.0 },
-            max: 2 * len,
-        }
-    }
-
-    #[inline(always)]
-    fn of(self, x: f64) -> usize {
-        ((x * self.inv + ROUND)
-            .to_bits()
-            .wrapping_sub(ROUND.to_bits()) as usize)
-            .min(self.max)
-    }
-
-    /// Sets `guide[start..k] = s` (`start <= k <= max + 1`; short runs as a fixed-width
-    /// store whose excess the next call overwrites) and returns `k`.
-    #[inline(always)]
-    fn extend(self, guide: &mut [u16], start: usize, k: usize, s: usize) -> usize {
-        if k - start <= RUN {
-            guide[start..start + RUN].fill(s as u16);
-        } else {
-            guide[start..k].fill(s as u16);
-        }
-        k
-    }
-}
-
-/// `draws` i.i.d. draws from the residuals of one block (cumulative sums `cum[..len]`, then
-/// [`PROBE`] infinities; total `sb > 0`; `lb` the first index with `cum[lb] = sb`), each
-/// adding one to `count` of its particle; `guide` built on `g` over `cum[..len]`.
-#[allow(clippy::too_many_arguments)]
-#[inline]
-fn draw_in_block<R: Rng + ?Sized>(
-    cum: &[f64],
-    sb: f64,
-    lb: usize,
-    g: Buckets,
-    draws: u64,
-    rng: &mut R,
-    count: &mut [u32],
-    guide: &[u16],
-) {
-    let unit = sb * (1.0 / (1u64 << 53) as f64);
-    for _ in 0..draws {
-        let u = (rng.next_u64() >> 11) as f64 * unit;
-        let s0 = guide[g.of(u)] as usize;
-        let mut s = s0;
-        for &c in &cum[s0..s0 + PROBE] {
-            s += usize::from(c <= u);
-        }
-        if s == s0 + PROBE {
-            while cum[s] <= u {
-                s += 1;
-            }
-        }
-        count[s.min(lb)] += 1;
     }
 }
 

@@ -517,17 +517,29 @@ fn residual_extras(w: &[f64], n: usize, reps: usize, seed: u64) -> (Vec<f64>, Ve
 /// (for these sample sizes nearly so); the check is `|stat - d| < 6 sqrt(2 d)`. Variances:
 /// `sum_i Var[extra_i] = m (1 - sum p_i^2)`, checked within 3%, which a systematic or
 /// stratified remainder (variance at most 1/4 per particle, sum far below `m`) fails.
+///
+/// Two inputs, so that both ways of drawing within a block are checked: residuals 0, 0,
+/// 1/2, 1/2 (per group of 4) over 5000 particles, whose full blocks (acceptance exactly 1/4)
+/// draw by rejection and whose last block (904 particles, 226 of residual on 1024 slots)
+/// by search; and residuals 1/4, 3/4, 1/4, 3/4 over 4696 particles, whose last block (600
+/// particles on 1024 slots, acceptance 0.29) draws by rejection with 424 empty slots.
 #[test]
 fn residual_remainder_is_multinomial() {
     // per group of 4: weight 0 (never drawn), 1 (n w = 2, no residual), 0.75, 0.25
-    let pattern = [0.0, 1.0, 0.75, 0.25];
-    let len = 5000; // 3 blocks of 2048, the last partial
+    assert_multinomial_remainder(&[0.0, 1.0, 0.75, 0.25], 5000, 11);
+    // n w = 0.25, 0.75, 1.25, 1.75
+    assert_multinomial_remainder(&[0.125, 0.375, 0.625, 0.875], 4696, 12);
+}
+
+/// [`residual_remainder_is_multinomial`] on `len` weights repeating `pattern` (which sums
+/// to 2, so that `n / W = 2` for `n = len`, a multiple of 4).
+fn assert_multinomial_remainder(pattern: &[f64; 4], len: usize, seed: u64) {
     let w: Vec<f64> = (0..len).map(|i| pattern[i % 4]).collect();
-    let total: f64 = w.iter().sum(); // 2500: n / W = 2 for n = 5000
-    let n = 5000;
+    let total: f64 = w.iter().sum();
+    let n = len;
     assert_eq!(n as f64 / total, 2.0);
     let reps = 3000;
-    let (mean, var, m) = residual_extras(&w, n, reps, 11);
+    let (mean, var, m) = residual_extras(&w, n, reps, seed);
     let scale = n as f64 / total;
     let r: Vec<f64> = w.iter().map(|&x| x * scale - (x * scale).floor()).collect();
     let s: f64 = r.iter().sum();
@@ -581,6 +593,16 @@ fn residual_remainder_single_residual_per_block() {
     assert!((mean[10] - 0.5).abs() < 5.0 * sd, "{}", mean[10]);
     assert!((mean[4500] - 0.5).abs() < 5.0 * sd, "{}", mean[4500]);
     assert_eq!(mean[10] + mean[4500], 1.0);
+    // a last block of one particle (2049 = 2048 + 1), whose draw goes by rejection over
+    // two slots, the second empty; the other residual is in the first block (by search)
+    let mut w = vec![1.0; 2049];
+    w[0] = 0.5;
+    w[2048] = 1.5;
+    let (mean, _, m) = residual_extras(&w, 2049, reps, 14);
+    assert_eq!(m, 1);
+    assert!((mean[0] - 0.5).abs() < 5.0 * sd, "{}", mean[0]);
+    assert!((mean[2048] - 0.5).abs() < 5.0 * sd, "{}", mean[2048]);
+    assert_eq!(mean[0] + mean[2048], 1.0);
 }
 
 /// No remainder (`n w_i` all integers, over several blocks): the copies only, whatever the
