@@ -1,7 +1,7 @@
 //! Resamplers against the numpy/filterpy fixture (exact indices for given uniforms), their
 //! statistical unbiasedness with a fixed seed, the edges, and every error variant.
 
-use rand::SeedableRng;
+use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::Value;
 use trajpred_particle::{
@@ -523,13 +523,18 @@ fn residual_extras(w: &[f64], n: usize, reps: usize, seed: u64) -> (Vec<f64>, Ve
 /// draw by rejection and whose last block (904 particles, 226 of residual on 2048 slots)
 /// by search; and residuals 1/4, 3/4, 1/4, 3/4 over 5296 particles, whose last block (1200
 /// particles, 600 of residual on 2048 slots, acceptance 0.29) draws by rejection with 848
-/// empty slots.
+/// empty slots; and 5000 i.i.d. uniform weights, whose residuals use all their digits.
 #[test]
 fn residual_remainder_is_multinomial() {
     // per group of 4: weight 0 (never drawn), 1 (n w = 2, no residual), 0.75, 0.25
     assert_multinomial_remainder(&[0.0, 1.0, 0.75, 0.25], 5000, 11);
     // n w = 0.25, 0.75, 1.25, 1.75
     assert_multinomial_remainder(&[0.125, 0.375, 0.625, 0.875], 5296, 12);
+    // i.i.d. uniform weights (residuals with all their digits): full blocks by rejection
+    // (acceptance about 1/2), the last (904 particles) by search
+    let mut wrng = ChaCha8Rng::seed_from_u64(3);
+    let w: Vec<f64> = (0..5000).map(|_| wrng.random::<f64>()).collect();
+    assert_multinomial_extras(&w, 13);
 }
 
 /// [`residual_remainder_is_multinomial`] on `len` weights repeating `pattern` (which sums
@@ -537,14 +542,25 @@ fn residual_remainder_is_multinomial() {
 fn assert_multinomial_remainder(pattern: &[f64; 4], len: usize, seed: u64) {
     let w: Vec<f64> = (0..len).map(|i| pattern[i % 4]).collect();
     let total: f64 = w.iter().sum();
+    assert_eq!(len as f64 / total, 2.0);
+    let m = assert_multinomial_extras(&w, seed);
+    // every n w_i is exact here, so the residuals sum to m exactly
+    let s: f64 = w.iter().map(|&x| 2.0 * x - (2.0 * x).floor()).sum();
+    assert_eq!(m as f64, s);
+}
+
+/// The remainder of residual resampling of `w` into `n = w.len()` places, over 3000 seeded
+/// runs, against the multinomial (see [`residual_remainder_is_multinomial`]); returns `m`.
+fn assert_multinomial_extras(w: &[f64], seed: u64) -> usize {
+    let len = w.len();
     let n = len;
-    assert_eq!(n as f64 / total, 2.0);
+    let total: f64 = w.iter().sum();
     let reps = 3000;
-    let (mean, var, m) = residual_extras(&w, n, reps, seed);
+    let (mean, var, m) = residual_extras(w, n, reps, seed);
     let scale = n as f64 / total;
     let r: Vec<f64> = w.iter().map(|&x| x * scale - (x * scale).floor()).collect();
     let s: f64 = r.iter().sum();
-    assert_eq!(m as f64, s);
+    assert!((m as f64 - s).abs() < 1e-6 * s, "m {m}, residual sum {s}");
     let mut stat = 0.0;
     let mut d = 0.0;
     let mut sum_var = 0.0;
@@ -575,6 +591,7 @@ fn assert_multinomial_remainder(pattern: &[f64; 4], len: usize, seed: u64) {
         (sum_var / expected - 1.0).abs() < 0.03,
         "sum of variances {sum_var}, multinomial {expected}"
     );
+    m
 }
 
 /// One positive residual per block: blocks 0 and 2 each hold one particle with residual
