@@ -29,7 +29,7 @@
 //! of a binary search per draw. The residual scheme draws its remainder per block of
 //! particles: the block's number of draws is binomial given the draws left (the conditional
 //! law of a multinomial's block totals), and each draw is a slot of the block accepted with
-//! probability its residual (rejection from one 64-bit draw per try, about one try per
+//! probability its residual (rejection, two tries per 64-bit draw, about one try per
 //! particle; blocks whose residual is concentrated on few particles search their cumulative
 //! residuals instead); the copies and the drawn places are then written per particle in one
 //! streaming pass. From `2^17` weights on, the residual scheme first cuts the particles into
@@ -860,7 +860,7 @@ fn residual_blocks<R: Rng + ?Sized>(
                 coarse[len..].fill(0);
                 draw_by_rejection(&resid, &coarse, draws, rng, &mut count);
             } else {
-                draw_by_search(&resid[..len], draws, rng, &mut count[..len]);
+                draw_by_search(&mut resid[..len], draws, rng, &mut count[..len]);
             }
         }
         let base = first + b * BLOCK;
@@ -961,18 +961,18 @@ fn draw_by_rejection<R: Rng + ?Sized>(
     }
 }
 
-/// `draws` i.i.d. draws from the residuals `resid` (positive sum), each located in their
-/// cumulative sums by binary search and adding one to `count` of its particle; a draw that
-/// rounding puts at or past the total selects the last positive residual.
-fn draw_by_search<R: Rng + ?Sized>(resid: &[f64], draws: u64, rng: &mut R, count: &mut [u32]) {
-    let mut cum = [0.0f64; BLOCK];
-    let cum = &mut cum[..resid.len()];
-    let mut c = 0.0f64;
-    for (d, &r) in cum.iter_mut().zip(resid) {
-        c += r;
-        *d = c;
-    }
+/// `draws` i.i.d. draws from the residuals `resid` (positive sum; turned into their
+/// cumulative sums in place), each located by binary search and adding one to `count` of
+/// its particle; a draw that rounding puts at or past the total selects the last positive
+/// residual.
+fn draw_by_search<R: Rng + ?Sized>(resid: &mut [f64], draws: u64, rng: &mut R, count: &mut [u32]) {
     let last = resid.iter().rposition(|&r| r > 0.0).unwrap_or(0);
+    let mut c = 0.0f64;
+    for r in resid.iter_mut() {
+        c += *r;
+        *r = c;
+    }
+    let cum = &*resid;
     let unit = c * (1.0 / (1u64 << 53) as f64);
     for _ in 0..draws {
         let u = (rng.next_u64() >> 11) as f64 * unit;
