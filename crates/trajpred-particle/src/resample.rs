@@ -221,6 +221,13 @@ fn fill_run(out: &mut [usize], start: usize, end: usize, i: usize) {
 /// low bits of the sum.
 const ROUND: f64 = 6_755_399_441_055_744.0;
 
+/// The integer held in the low bits of `y = x + ROUND` (`x` rounded to the nearest
+/// integer, `0 <= x < 2^51`), without a conversion instruction.
+#[inline(always)]
+fn rounded(y: f64) -> usize {
+    y.to_bits().wrapping_sub(ROUND.to_bits()) as usize
+}
+
 /// For `h ~ e + 1/2` with `e >= -1`: returns the integer nearest to `h` (which is `ceil(e)`
 /// unless `e` is within a rounding error of an integer) and `near`, true when `h` lies
 /// within `margin` of a half-integer (`e` within `margin` of an integer: the caller then
@@ -230,8 +237,7 @@ const ROUND: f64 = 6_755_399_441_055_744.0;
 fn ceil_near(h: f64, margin: f64) -> (usize, bool) {
     let y = h + ROUND;
     let d = (y - ROUND) - h;
-    let r = y.to_bits().wrapping_sub(ROUND.to_bits()) as usize;
-    (r, d.abs() > 0.5 - margin)
+    (rounded(y), d.abs() > 0.5 - margin)
 }
 
 /// Particles (and output slots) from which [`systematic_counts`] splits its pass in two
@@ -742,7 +748,7 @@ fn split(w: f64, scale: f64) -> (usize, f64) {
     let x = w * scale;
     let y = (x - 0.5) + ROUND;
     let f = y - ROUND;
-    let i = y.to_bits().wrapping_sub(ROUND.to_bits()) as usize;
+    let i = rounded(y);
     let r = x - f;
     let over = r >= 1.0;
     (
@@ -892,9 +898,7 @@ fn block_residuals(
     let one = |w: f64, r: &mut f64, c: &mut u32, n: &mut u32| {
         let (f, x) = split(w, scale);
         *r = x;
-        *c = ((x * digits - 0.5) + ROUND)
-            .to_bits()
-            .wrapping_sub(ROUND.to_bits()) as u32;
+        *c = rounded((x * digits - 0.5) + ROUND) as u32;
         *n = f as u32;
         x
     };
@@ -976,8 +980,7 @@ fn draw_by_search<R: Rng + ?Sized>(resid: &mut [f64], draws: u64, rng: &mut R, c
     let unit = c * (1.0 / (1u64 << 53) as f64);
     for _ in 0..draws {
         let u = (rng.next_u64() >> 11) as f64 * unit;
-        let s = cum.partition_point(|&c| c <= u);
-        count[s.min(last)] += 1;
+        count[search(cum, u, last)] += 1;
     }
 }
 
