@@ -5,7 +5,7 @@
 
 use crate::error::Result;
 use crate::filter::{InputChecks, Step, Update, gaussian_log_likelihood, validate_state};
-use crate::linalg::{check_dim, check_finite, cholesky, symmetrise};
+use crate::linalg::{check_dim, check_finite, ldl, symmetrise};
 use crate::model::{LinearObservation, LinearTransition, Observation, Transition, validate_models};
 use crate::motion::{CoordinatedTurn, RangeBearing};
 use crate::ukf::{MerweSigmaPoints, SigmaWeights};
@@ -269,7 +269,7 @@ impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
         let ob = &self.observation;
         check_dim("observation", ob.observation_dim(), z.nrows())?;
         check_finite(z, "observation")?;
-        let chol = cholesky(mo.s.clone(), "S")?;
+        let chol = ldl(mo.s.clone(), "S")?;
         let mut kt = mo.cross.transpose();
         chol.solve_mut(&mut kt);
         let gain = kt.transpose();

@@ -4,9 +4,9 @@
 
 use crate::error::{KalmanError, Result};
 use crate::linalg::{
-    Chol, all_finite, check_dim, check_finite, check_square, check_state, cholesky, congruence_ldl,
-    is_static, joseph, mean_finite_and_symmetric, mul, mul_tr_sym_plus, mul_vec,
-    positive_definite_shifted, symmetrise,
+    Ldl, all_finite, check_dim, check_finite, check_square, check_state, congruence_ldl, is_static,
+    joseph, ldl, mean_finite_and_symmetric, mul, mul_tr_sym_plus, mul_vec,
+    positive_definite_minors, symmetrise,
 };
 use crate::model::{LinearTransitionModel, Observation};
 use nalgebra::allocator::Allocator;
@@ -258,7 +258,7 @@ where
         let mut out: Vec<Gaussian<T, D>> = filtered.to_vec();
         for k in (0..filtered.len().saturating_sub(1)).rev() {
             let (pred, cross) = self.prediction_with_cross_covariance(&filtered[k])?;
-            let chol = cholesky(pred.covariance.clone(), "P(k+1|k)")?;
+            let chol = ldl(pred.covariance.clone(), "P(k+1|k)")?;
             // G^T = P(k+1|k)^-1 C^T, since P(k+1|k) is symmetric
             let mut gt = cross.transpose();
             chol.solve_mut(&mut gt);
@@ -349,7 +349,7 @@ where
         // positive definite
         let fast_ok = mean_finite_and_symmetric(state);
         let p = if tr.has_structured_propagation() {
-            (fast_ok && positive_definite_shifted(state.covariance.clone(), T::zero()))
+            (fast_ok && positive_definite_minors(state.covariance.clone()))
                 .then(|| tr.propagate_covariance(&state.covariance))
         } else {
             congruence_ldl(f, &state.covariance, tr.process_noise()).filter(|_| fast_ok)
@@ -480,7 +480,7 @@ where
         + Allocator<M, D>,
 {
     let p = &prior.covariance;
-    let chol = cholesky(s.clone(), "S")?;
+    let chol = ldl(s.clone(), "S")?;
     // K^T = S^-1 H P (P symmetric)
     let mut kt = hp.clone();
     chol.solve_mut(&mut kt);
@@ -518,21 +518,19 @@ where
     })
 }
 
-/// `ln N(y; 0, S)` from the Cholesky factor of `S`.
+/// `ln N(y; 0, S)` from the `L D L^T` factorisation of `S`.
 #[inline(always)]
-pub(crate) fn gaussian_log_likelihood<T, M>(chol: &Chol<T, M>, y: &OVector<T, M>) -> T
+pub(crate) fn gaussian_log_likelihood<T, M>(s: &Ldl<T, M>, y: &OVector<T, M>) -> T
 where
     T: RealField + Copy,
     M: Dim,
     DefaultAllocator: Allocator<M> + Allocator<M, M>,
 {
-    let mut w = y.clone();
-    chol.solve_lower_mut(&mut w);
     let m = nalgebra::convert::<f64, T>(y.nrows() as f64);
     let half = nalgebra::convert::<f64, T>(0.5);
     // ln(2 pi)
     let ln_two_pi = nalgebra::convert::<f64, T>(1.837_877_066_409_345_5);
-    -half * (m * ln_two_pi + chol.log_det() + w.norm_squared())
+    -half * (m * ln_two_pi + s.log_det() + s.quadratic_form(y))
 }
 
 /// Validates a state against the transition's dimension (shared by every filter's steps).

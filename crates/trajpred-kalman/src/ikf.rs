@@ -17,7 +17,7 @@
 
 use crate::error::Result;
 use crate::filter::{CovarianceUpdate, InputChecks, validate_state};
-use crate::linalg::{check_dim, check_finite, check_pd, cholesky, symmetrise};
+use crate::linalg::{check_dim, check_finite, check_pd, ldl, symmetrise};
 use crate::model::{LinearObservationModel, LinearTransitionModel, validate_models};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
@@ -246,7 +246,7 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
         let h = self.observation.observation_matrix();
         let p = &prior.covariance;
         let hp = h * p;
-        let chol = cholesky(previous.covariance.clone(), "S")?;
+        let chol = ldl(previous.covariance.clone(), "S")?;
         let mut kt = hp.clone();
         chol.solve_mut(&mut kt);
         let gain = kt.transpose();

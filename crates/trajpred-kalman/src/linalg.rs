@@ -337,62 +337,137 @@ where
     pub(crate) fn unpack(self) -> OMatrix<T, D, D> {
         self.l
     }
+}
 
-    /// Solves `L w = b` in place, column by column.
+/// The factorisation `A = L D L^T` of a symmetric positive definite matrix (`L` unit lower
+/// triangular, `D` diagonal and positive), for solves and log-determinants: no square roots,
+/// and one division per pivot (the reciprocals are kept, so solves only multiply). Reads
+/// only the lower triangle.
+#[derive(Debug, Clone)]
+pub(crate) struct Ldl<T: RealField, D: Dim>
+where
+    DefaultAllocator: Allocator<D, D> + Allocator<D>,
+{
+    /// `L` below the diagonal (the diagonal and upper triangle are scratch).
+    l: OMatrix<T, D, D>,
+    d: OVector<T, D>,
+    inv_d: OVector<T, D>,
+}
+
+impl<T: RealField + Copy, D: Dim> Ldl<T, D>
+where
+    DefaultAllocator: Allocator<D, D> + Allocator<D>,
+{
+    /// Factorises `a + shift I` and returns the factors with the verdict: every pivot
+    /// `d_j` strictly positive and finite. One verdict accumulated without branches (after
+    /// a bad pivot the remaining arithmetic is harmless and the factors are meaningless).
     #[inline(always)]
-    pub(crate) fn solve_lower_mut<C: Dim>(&self, b: &mut OMatrix<T, D, C>)
+    pub(crate) fn factor(mut a: OMatrix<T, D, D>, shift: T) -> (Self, bool) {
+        let (dd, _) = a.shape_generic();
+        let n = dd.value();
+        let big = T::max_value().unwrap_or(T::one() / T::zero());
+        let mut d = OVector::<T, D>::zeros_generic(dd, Const::<1>);
+        let mut inv_d = OVector::<T, D>::zeros_generic(dd, Const::<1>);
+        let mut ok = true;
+        for j in 0..n {
+            // row j of L is in a[(j, k)], k < j; w_k = L_jk d_k goes to the unused a[(k, j)]
+            let mut dj = a[(j, j)] + shift;
+            for k in 0..j {
+                let w = a[(j, k)] * d[k];
+                a[(k, j)] = w;
+                dj -= a[(j, k)] * w;
+            }
+            ok &= (dj > T::zero()) & (dj <= big);
+            d[j] = dj;
+            let inv = T::one() / dj;
+            inv_d[j] = inv;
+            for i in (j + 1)..n {
+                let mut s = a[(i, j)];
+                for k in 0..j {
+                    s -= a[(i, k)] * a[(k, j)];
+                }
+                a[(i, j)] = s * inv;
+            }
+        }
+        (Ldl { l: a, d, inv_d }, ok)
+    }
+
+    /// Solves `L w = b` in place, column by column (`L` unit lower triangular).
+    #[inline(always)]
+    fn solve_unit_lower_mut<C: Dim>(&self, b: &mut OMatrix<T, D, C>)
     where
         DefaultAllocator: Allocator<D, C>,
     {
         let n = self.l.nrows();
         for c in 0..b.ncols() {
-            for i in 0..n {
+            for i in 1..n {
                 let mut s = b[(i, c)];
                 for k in 0..i {
                     s -= self.l[(i, k)] * b[(k, c)];
                 }
-                b[(i, c)] = s / self.l[(i, i)];
+                b[(i, c)] = s;
             }
         }
     }
 
-    /// Solves `A x = b` (`A = L L^T`) in place.
+    /// Solves `A x = b` in place: `L w = b`, `D v = w`, `L^T x = v`.
     #[inline(always)]
     pub(crate) fn solve_mut<C: Dim>(&self, b: &mut OMatrix<T, D, C>)
     where
         DefaultAllocator: Allocator<D, C>,
     {
-        self.solve_lower_mut(b);
+        self.solve_unit_lower_mut(b);
         let n = self.l.nrows();
         for c in 0..b.ncols() {
             for i in (0..n).rev() {
-                let mut s = b[(i, c)];
+                let mut s = b[(i, c)] * self.inv_d[i];
                 for k in (i + 1)..n {
                     s -= self.l[(k, i)] * b[(k, c)];
                 }
-                b[(i, c)] = s / self.l[(i, i)];
+                b[(i, c)] = s;
             }
         }
     }
 
-    /// `ln det A = 2 sum ln L_ii` (one logarithm of the product when it is representable).
+    /// `ln det A = ln prod d_i` (one logarithm of the product when it is representable:
+    /// finite and not below `1 / max`, so it keeps all but at most two bits of precision).
     #[inline(always)]
     pub(crate) fn log_det(&self) -> T {
-        let n = self.l.nrows();
         let mut prod = T::one();
-        for i in 0..n {
-            prod *= self.l[(i, i)];
+        for &di in self.d.iter() {
+            prod *= di;
         }
-        let two = T::one() + T::one();
-        if prod > T::zero() && prod.is_finite() && prod > T::min_value().unwrap_or(T::zero()) {
-            two * prod.ln()
+        let big = T::max_value().unwrap_or(T::one() / T::zero());
+        if prod >= T::one() / big && prod <= big {
+            prod.ln()
         } else {
-            let mut s = T::zero();
-            for i in 0..n {
-                s += self.l[(i, i)].ln();
-            }
-            two * s
+            self.d.iter().fold(T::zero(), |s, &di| s + di.ln())
         }
+    }
+
+    /// The quadratic form `y^T A^-1 y = sum_i w_i^2 / d_i` with `L w = y`.
+    #[inline(always)]
+    pub(crate) fn quadratic_form(&self, y: &OVector<T, D>) -> T {
+        let mut w = y.clone();
+        self.solve_unit_lower_mut(&mut w);
+        w.iter()
+            .zip(self.inv_d.iter())
+            .fold(T::zero(), |s, (&wi, &inv)| s + wi * wi * inv)
+    }
+}
+
+/// The `L D L^T` factorisation of a symmetric positive definite matrix, or
+/// [`KalmanError::NotPositiveDefinite`] naming `what`.
+#[inline(always)]
+pub(crate) fn ldl<T, D>(m: OMatrix<T, D, D>, what: &'static str) -> Result<Ldl<T, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D> + Allocator<D>,
+{
+    match Ldl::factor(m, T::zero()) {
+        (f, true) => Ok(f),
+        _ => Err(KalmanError::NotPositiveDefinite { what }),
     }
 }
 
@@ -422,7 +497,7 @@ pub(crate) fn check_psd<T, D>(m: &OMatrix<T, D, D>, what: &'static str) -> Resul
 where
     T: RealField + Copy,
     D: Dim,
-    DefaultAllocator: Allocator<D, D>,
+    DefaultAllocator: Allocator<D, D> + Allocator<D>,
 {
     if is_psd(m) {
         Ok(())
@@ -439,7 +514,7 @@ pub(crate) fn is_psd<T, D>(m: &OMatrix<T, D, D>) -> bool
 where
     T: RealField + Copy,
     D: Dim,
-    DefaultAllocator: Allocator<D, D>,
+    DefaultAllocator: Allocator<D, D> + Allocator<D>,
 {
     if !all_finite(m) {
         return false;
@@ -527,7 +602,7 @@ fn psd_error<T, D>(m: &OMatrix<T, D, D>, what: &'static str) -> Result<()>
 where
     T: RealField + Copy,
     D: Dim,
-    DefaultAllocator: Allocator<D, D>,
+    DefaultAllocator: Allocator<D, D> + Allocator<D>,
 {
     check_finite(m, what)?;
     let n = m.nrows();
@@ -555,39 +630,51 @@ where
 }
 
 /// Whether the symmetric matrix `a + shift I` (lower triangle read) is positive definite:
-/// an `L D L^T` factorisation without square roots and with one division per pivot, all
-/// pivots `d_j` strictly positive and finite. Cheaper than [`Chol::new`] when only the
-/// verdict is needed.
+/// its [`Ldl`] factorisation has all pivots strictly positive and finite (cheaper than
+/// [`Chol::new`]: no square roots).
 #[inline(always)]
-pub(crate) fn positive_definite_shifted<T, D>(mut a: OMatrix<T, D, D>, shift: T) -> bool
+pub(crate) fn positive_definite_shifted<T, D>(a: OMatrix<T, D, D>, shift: T) -> bool
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D> + Allocator<D>,
+{
+    Ldl::factor(a, shift).1
+}
+
+/// Whether the symmetric matrix `a` (lower triangle read) is positive definite, by
+/// fraction-free (Bareiss) elimination: after step `k` the trailing entries are the Schur
+/// complement scaled by the leading `k + 1` minor, computed as
+/// `(p_k a_ij - a_ik a_jk) / p_(k-1)` with `p_k` the `k`-th pivot. The pivots `p_k` are the
+/// leading principal minors, all strictly positive (and finite) exactly for a positive
+/// definite matrix (Sylvester). Each step divides by the pivot of the step before, whose
+/// reciprocal is formed while that step's products run, so no division waits on the
+/// critical path (the `L D L^T` loop waits for one per pivot); the rounding of each entry
+/// is that of the `L D L^T` update scaled by a positive factor. The minors grow like the
+/// `k`-th power of the entries: a matrix whose leading minors over- or underflow is
+/// reported as not positive definite, and the caller falls back to [`is_psd`].
+#[inline(always)]
+pub(crate) fn positive_definite_minors<T, D>(mut a: OMatrix<T, D, D>) -> bool
 where
     T: RealField + Copy,
     D: Dim,
     DefaultAllocator: Allocator<D, D>,
 {
     let n = a.nrows();
-    // `0 < d <= max` is false for a NaN or infinite pivot too: one verdict accumulated
-    // without branches (after a bad pivot the remaining arithmetic is harmless)
     let big = T::max_value().unwrap_or(T::one() / T::zero());
+    // `T::min_value()` is the most negative value, not the smallest positive one
+    let tiny = T::one() / big;
     let mut ok = true;
-    for j in 0..n {
-        // row j of L is in a[(j, k)], k < j; w_k = L_jk d_k goes to the unused a[(k, j)]
-        let mut d = a[(j, j)] + shift;
-        for k in 0..j {
-            let w = a[(j, k)] * a[(k, k)];
-            a[(k, j)] = w;
-            d -= a[(j, k)] * w;
-        }
-        ok &= (d > T::zero()) & (d <= big);
-        a[(j, j)] = d;
-        let inv = T::one() / d;
-        for i in (j + 1)..n {
-            let mut s = a[(i, j)];
-            for k in 0..j {
-                s -= a[(i, k)] * a[(k, j)];
+    let mut inv_prev = T::one();
+    for k in 0..n {
+        let p = a[(k, k)];
+        ok &= (p >= tiny) & (p <= big);
+        for j in (k + 1)..n {
+            for i in j..n {
+                a[(i, j)] = (p * a[(i, j)] - a[(i, k)] * a[(j, k)]) * inv_prev;
             }
-            a[(i, j)] = s * inv;
         }
+        inv_prev = T::one() / p;
     }
     ok
 }

@@ -14,7 +14,7 @@
 use crate::error::Result;
 use crate::filter::{Filter, InputChecks, validate_state};
 use crate::kf::Kf;
-use crate::linalg::{check_dim, check_finite, cholesky, symmetrise};
+use crate::linalg::{check_dim, check_finite, ldl, symmetrise};
 use crate::model::{LinearObservationModel, LinearTransitionModel};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OVector, RealField};
@@ -70,7 +70,7 @@ impl<Tr, Ob> Kf<Tr, Ob> {
         let hp = h * p;
         let mut s = &hp * h.transpose() + ob.observation_noise();
         symmetrise(&mut s);
-        let chol = cholesky(s, "S")?;
+        let chol = ldl(s, "S")?;
         // H P A^T (m x n); K = A P H^T S^-1 = (S^-1 H P A^T)^T
         let hpa = &hp * a.transpose();
         let mut kt = hpa.clone();

@@ -4,7 +4,7 @@
 
 use crate::error::Result;
 use crate::filter::gaussian_log_likelihood;
-use crate::linalg::{Chol, check_dim, check_finite, cholesky};
+use crate::linalg::{Chol, check_dim, check_finite, cholesky, ldl};
 use crate::model::{Observation, Transition};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
@@ -14,21 +14,23 @@ use rand_distr::StandardNormal;
 
 /// A square root `L` of a covariance (`L L^T = C`) for sampling: the Cholesky factor, or for a
 /// positive semi-definite but singular `C` (the discrete white-noise `Q`), the factor of
-/// `C + 64 n eps max|C| I`.
+/// `C + 64 n eps max|C| I`; for `C = 0` the zero matrix.
 pub fn covariance_sqrt<T, D>(c: &OMatrix<T, D, D>, what: &'static str) -> Result<OMatrix<T, D, D>>
 where
     T: RealField + Copy,
     D: Dim,
-    DefaultAllocator: Allocator<D, D>,
+    DefaultAllocator: Allocator<D, D> + Allocator<D>,
 {
     crate::linalg::check_psd(c, what)?;
     if let Some(ch) = Chol::new(c.clone()) {
         return Ok(ch.unpack());
     }
     let n = c.nrows();
-    let jitter = T::default_epsilon()
-        * nalgebra::convert::<f64, T>(64.0 * n as f64)
-        * c.amax().max(T::min_value().unwrap_or(T::zero()));
+    let scale = c.amax();
+    if scale == T::zero() {
+        return Ok(c.clone());
+    }
+    let jitter = T::default_epsilon() * nalgebra::convert::<f64, T>(64.0 * n as f64) * scale;
     let mut shifted = c.clone();
     for i in 0..n {
         shifted[(i, i)] += jitter;
@@ -85,6 +87,6 @@ where
     let zp = observation.observe(x)?;
     check_dim("h(x)", m, zp.nrows())?;
     let y = observation.observation_residual(z, &zp);
-    let chol = cholesky(observation.observation_noise().clone(), "R")?;
+    let chol = ldl(observation.observation_noise().clone(), "R")?;
     Ok(gaussian_log_likelihood(&chol, &y))
 }

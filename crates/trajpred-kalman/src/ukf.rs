@@ -6,7 +6,9 @@ use crate::filter::{
     Filter, InputChecks, PredictionWithCross, Smoother, Update, gaussian_log_likelihood,
     validate_state,
 };
-use crate::linalg::{check_dim, check_finite, cholesky, mul, mul_tr_sym_plus, mul_vec, symmetrise};
+use crate::linalg::{
+    check_dim, check_finite, cholesky, ldl, mul, mul_tr_sym_plus, mul_vec, symmetrise,
+};
 use crate::model::{Observation, SigmaImages, Transition, validate_models};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
@@ -364,7 +366,7 @@ where
         let z_hat = ob.normalize_observation(t.mean);
         let mut s = t.covariance + ob.observation_noise();
         symmetrise(&mut s);
-        let chol = cholesky(s.clone(), "S")?;
+        let chol = ldl(s.clone(), "S")?;
         let mut kt = t.cross.transpose();
         chol.solve_mut(&mut kt);
         let gain = kt.transpose();

@@ -17,9 +17,10 @@ use trajpred_kalman::motion::{
 };
 use trajpred_kalman::sampling::{covariance_sqrt, observation_log_likelihood, sample_transition};
 use trajpred_kalman::{
-    AugmentedUkf, CoordinatedTurn, CovarianceUpdate, Ekf, Filter, Ikf, Innovation, InputChecks, Kf,
-    LinearObservation, LinearTransition, MerweSigmaPoints, MultiStep, NoisyTransition, Observation,
-    ObservationJacobian, RangeBearing, Smoother, Transition, TransitionJacobian, Ukf,
+    AugmentedUkf, CoordinatedTurn, CovarianceUpdate, Ekf, Filter, Ikf, Innovation, InputChecks,
+    KalmanError, Kf, LinearObservation, LinearTransition, MerweSigmaPoints, MultiStep,
+    NoisyTransition, Observation, ObservationJacobian, RangeBearing, Smoother, Transition,
+    TransitionJacobian, Ukf,
 };
 
 fn assert_close<R: nalgebra::Dim, C: nalgebra::Dim, S1, S2>(
@@ -723,4 +724,71 @@ fn batch_sigma_point_images_equal_the_per_point_ones() {
             }
         }
     }
+}
+
+#[test]
+fn predict_accepts_and_rejects_p_at_every_scale() {
+    // P = V diag(e) V^T with a seeded random orthogonal V: the fast definiteness check of the
+    // predict (leading minors for a structured F, L D L^T fused with F P F^T for a dense F)
+    // must agree with the exact check whatever the scale, including scales at which the
+    // minors of a 4 x 4 matrix (the 4th power of the entries) under- or overflow and the
+    // check falls back to the exact one
+    let mut rng = ChaCha8Rng::seed_from_u64(17);
+    let g = Matrix4::from_fn(|_, _| rng.sample::<f64, _>(StandardNormal));
+    let v = g.qr().q();
+    let (structured, ob) = cv2_models();
+    let dense_f = Matrix4::new(
+        1.0, 0.1, 0.02, 0.0, 0.0, 0.9, 0.1, 0.0, 0.05, 0.0, 1.0, 0.2, 0.0, 0.0, 0.1, 0.8,
+    );
+    let dense = LinearTransition::new(dense_f, *structured.q()).unwrap();
+    let kfs = [
+        Kf::new(structured.clone(), ob.clone()).unwrap(),
+        Kf::new(dense, ob).unwrap(),
+    ];
+    let cases: [([f64; 4], bool); 5] = [
+        ([1.0, 0.5, 0.2, 0.1], true),
+        ([1.0, 1e-12, 0.3, 0.2], true), // positive definite, ill-conditioned
+        ([1.0, 0.0, 0.3, 0.2], true),   // semi-definite: accepted by the KF
+        ([1.0, -1e-6, 0.3, 0.2], false),
+        ([1.0, -0.5, 0.3, 0.2], false),
+    ];
+    for scale in [1e-150, 1e-20, 1.0, 1e20, 1e150] {
+        for (eig, accept) in cases {
+            let p = v * Matrix4::from_diagonal(&Vector4::from(eig)) * v.transpose() * scale;
+            let p = (p + p.transpose()) * 0.5;
+            let state = Gaussian {
+                mean: Vector4::new(1.0, 2.0, 3.0, 4.0),
+                covariance: p,
+            };
+            for kf in &kfs {
+                let r = kf.predict(&state);
+                if accept {
+                    let pred = r.unwrap_or_else(|e| panic!("{eig:?} x {scale:e}: {e}"));
+                    // the prediction of the path without the fast check (the same
+                    // products for the structured F; for the dense F the fused
+                    // `F L D L^T F^T` against `F P F^T`, equal to rounding)
+                    let cheap = kf
+                        .clone()
+                        .with_input_checks(InputChecks::Cheap)
+                        .predict(&state)
+                        .unwrap();
+                    assert_eq!(pred.mean, cheap.mean);
+                    let size = cheap.covariance.amax();
+                    let diff = (pred.covariance - cheap.covariance).amax();
+                    assert!(diff <= 1e-12 * size, "{eig:?} x {scale:e}: {diff:e}");
+                } else {
+                    assert!(
+                        matches!(r, Err(KalmanError::NotPositiveDefinite { what: "P" })),
+                        "{eig:?} x {scale:e}: {r:?}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn covariance_sqrt_of_zero_is_zero() {
+    let z = covariance_sqrt(&Matrix2::<f64>::zeros(), "Q").unwrap();
+    assert_eq!(z, Matrix2::zeros());
 }
