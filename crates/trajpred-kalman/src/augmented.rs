@@ -4,7 +4,7 @@
 //! enters the models non-additively is handled exactly as the paper does.
 
 use crate::error::Result;
-use crate::filter::{InputChecks, Step, Update, gaussian_log_likelihood, validate_state};
+use crate::filter::{InputChecks, Step, Update, validate_state};
 use crate::linalg::{check_dim, check_finite, ldl, symmetrise};
 use crate::model::{LinearObservation, LinearTransition, Observation, Transition, validate_models};
 use crate::motion::{CoordinatedTurn, RangeBearing};
@@ -279,19 +279,18 @@ impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
         symmetrise(&mut cov);
         check_finite(&mean, "posterior mean")?;
         check_finite(&cov, "posterior covariance")?;
-        let log_likelihood = gaussian_log_likelihood(&chol, &y);
         Ok(Step {
             prior: mo.prior,
-            update: Some(Update {
-                posterior: Gaussian {
+            update: Some(Update::new(
+                Gaussian {
                     mean,
                     covariance: cov,
                 },
-                innovation: y,
-                innovation_covariance: mo.s,
+                y,
+                &chol,
+                mo.s,
                 gain,
-                log_likelihood,
-            }),
+            )),
         })
     }
 

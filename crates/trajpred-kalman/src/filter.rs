@@ -56,8 +56,64 @@ where
     pub innovation_covariance: OMatrix<T, M, M>,
     /// The gain `K`.
     pub gain: OMatrix<T, D, M>,
-    /// `ln N(y; 0, S) = -(m ln 2 pi + ln det S + y^T S^-1 y) / 2`.
-    pub log_likelihood: T,
+    /// The normalised innovation squared `y^T S^-1 y` (the squared Mahalanobis distance of
+    /// the innovation, chi-square with `m` degrees of freedom under the model: for gating
+    /// and consistency tests).
+    pub nis: T,
+    /// `det S` from the factorisation of the update (for the log-likelihood, formed on
+    /// demand; 0 or infinite when it under- or overflows).
+    det_innovation_covariance: T,
+}
+
+impl<T: RealField + Copy, D: Dim, M: Dim> Update<T, D, M>
+where
+    DefaultAllocator:
+        Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M> + Allocator<D, M>,
+{
+    /// An update from its parts, `nis` and `det S` taken from the factorisation of `S`.
+    #[inline(always)]
+    pub(crate) fn new(
+        posterior: Gaussian<T, D>,
+        innovation: OVector<T, M>,
+        factor: &Ldl<T, M>,
+        innovation_covariance: OMatrix<T, M, M>,
+        gain: OMatrix<T, D, M>,
+    ) -> Self {
+        let nis = factor.quadratic_form(&innovation);
+        Update {
+            posterior,
+            innovation,
+            innovation_covariance,
+            gain,
+            nis,
+            det_innovation_covariance: factor.det(),
+        }
+    }
+
+    /// `ln N(y; 0, S) = -(m ln 2 pi + ln det S + y^T S^-1 y) / 2`, formed on demand from
+    /// [`Update::nis`] and `det S` (one logarithm; when `det S` under- or overflowed, `S`
+    /// is factorised again and the logarithms of its pivots are summed).
+    pub fn log_likelihood(&self) -> T {
+        let det = self.det_innovation_covariance;
+        let big = T::max_value().unwrap_or(T::one() / T::zero());
+        let log_det = if det >= T::one() / big && det <= big {
+            det.ln()
+        } else {
+            Ldl::factor(self.innovation_covariance.clone(), T::zero())
+                .0
+                .log_det()
+        };
+        log_likelihood_from(self.innovation.nrows(), log_det, self.nis)
+    }
+}
+
+/// `-(m ln 2 pi + ln det S + q) / 2`.
+fn log_likelihood_from<T: RealField + Copy>(m: usize, log_det: T, q: T) -> T {
+    let m = nalgebra::convert::<f64, T>(m as f64);
+    let half = nalgebra::convert::<f64, T>(0.5);
+    // ln(2 pi)
+    let ln_two_pi = nalgebra::convert::<f64, T>(1.837_877_066_409_345_5);
+    -half * (m * ln_two_pi + log_det + q)
 }
 
 /// One filter step: the prior `N(x(k|k-1), P(k|k-1))` and, when there was an observation,
@@ -95,7 +151,7 @@ where
     {
         self.update
             .as_ref()
-            .map_or_else(T::zero, |u| u.log_likelihood)
+            .map_or_else(T::zero, |u| u.log_likelihood())
     }
 }
 
@@ -410,7 +466,9 @@ where
     let mut s = OMatrix::<T, M, M>::zeros_generic(mm, mm);
     for b in 0..m {
         for a in b..m {
-            let v = hp[(a, at(b))] + (r[(a, b)] + r[(b, a)]) * half;
+            // from `P`, not from `hp` (element reads of elements just written one by one
+            // would be combined into wide reads that stall store forwarding)
+            let v = p[(at(a), at(b))] + (r[(a, b)] + r[(b, a)]) * half;
             s[(a, b)] = v;
             s[(b, a)] = v;
         }
@@ -496,26 +554,27 @@ where
     if form == CovarianceUpdate::Symmetrised {
         symmetrise(&mut cov);
     }
-    let log_likelihood = gaussian_log_likelihood(&chol, &y);
-    // one branch for the three output checks; the error is located only on failure
-    if !(all_finite(&mean) & all_finite(&cov) & log_likelihood.is_finite()) {
-        check_finite(&mean, "posterior mean")?;
-        check_finite(&cov, "posterior covariance")?;
-        return Err(KalmanError::NonFinite {
-            what: "log-likelihood",
-            index: 0,
-        });
-    }
-    Ok(Update {
-        posterior: Gaussian {
+    let update = Update::new(
+        Gaussian {
             mean,
             covariance: cov,
         },
-        innovation: y,
-        innovation_covariance: s,
+        y,
+        &chol,
+        s,
         gain,
-        log_likelihood,
-    })
+    );
+    // one branch for the three output checks; the error is located only on failure
+    let post = &update.posterior;
+    if !(all_finite(&post.mean) & all_finite(&post.covariance) & update.nis.is_finite()) {
+        check_finite(&post.mean, "posterior mean")?;
+        check_finite(&post.covariance, "posterior covariance")?;
+        return Err(KalmanError::NonFinite {
+            what: "normalised innovation squared",
+            index: 0,
+        });
+    }
+    Ok(update)
 }
 
 /// `ln N(y; 0, S)` from the `L D L^T` factorisation of `S`.
@@ -526,11 +585,7 @@ where
     M: Dim,
     DefaultAllocator: Allocator<M> + Allocator<M, M>,
 {
-    let m = nalgebra::convert::<f64, T>(y.nrows() as f64);
-    let half = nalgebra::convert::<f64, T>(0.5);
-    // ln(2 pi)
-    let ln_two_pi = nalgebra::convert::<f64, T>(1.837_877_066_409_345_5);
-    -half * (m * ln_two_pi + s.log_det() + s.quadratic_form(y))
+    log_likelihood_from(y.nrows(), s.log_det(), s.quadratic_form(y))
 }
 
 /// Validates a state against the transition's dimension (shared by every filter's steps).

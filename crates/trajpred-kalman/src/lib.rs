@@ -96,7 +96,7 @@
 //! let u = ukf.step(&particle, Some(&z))?; // UKF estimate ...
 //! let prior = ekf.predict(u.posterior())?; // ... as the prior of an EKF step
 //! let proposal = ekf.update(&prior, &z)?;
-//! assert!(proposal.log_likelihood.is_finite());
+//! assert!(proposal.log_likelihood().is_finite());
 //! # Ok::<(), trajpred_kalman::KalmanError>(())
 //! ```
 #![forbid(unsafe_code)]

@@ -429,14 +429,17 @@ where
         }
     }
 
+    /// `det A = prod d_i` (0 or infinite when the product under- or overflows).
+    #[inline(always)]
+    pub(crate) fn det(&self) -> T {
+        self.d.iter().fold(T::one(), |p, &di| p * di)
+    }
+
     /// `ln det A = ln prod d_i` (one logarithm of the product when it is representable:
     /// finite and not below `1 / max`, so it keeps all but at most two bits of precision).
     #[inline(always)]
     pub(crate) fn log_det(&self) -> T {
-        let mut prod = T::one();
-        for &di in self.d.iter() {
-            prod *= di;
-        }
+        let prod = self.det();
         let big = T::max_value().unwrap_or(T::one() / T::zero());
         if prod >= T::one() / big && prod <= big {
             prod.ln()

@@ -17,7 +17,8 @@
 
 use crate::error::Result;
 use crate::linalg::{
-    check_dim, check_finite, check_pd, check_psd, check_square, mul, mul_tr_sym_plus, mul_vec,
+    check_dim, check_finite, check_pd, check_psd, check_square, is_static, mul, mul_tr_sym_plus,
+    mul_vec,
 };
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
@@ -465,11 +466,13 @@ where
         &self.f
     }
 
-    /// `x + N x` over the non-zeros of `N` when `F = I + N` is sparse.
+    /// `x + N x` over the non-zeros of `N` when `F = I + N` is sparse and the size is known
+    /// at run time only; `F x` for static sizes, whose unrolled product stays in registers
+    /// (the same sums: the other terms are exact zeros added in the same column order).
     #[inline(always)]
     fn propagate_mean(&self, x: &OVector<T, D>) -> OVector<T, D> {
         match &self.shift {
-            Some(shift) => {
+            Some(shift) if !is_static::<D, D>() => {
                 let mut out = x.clone();
                 let last = x.nrows() - 1;
                 for &(i, j, a) in shift {
@@ -480,7 +483,7 @@ where
                 }
                 out
             }
-            None => mul_vec(&self.f, x),
+            _ => mul_vec(&self.f, x),
         }
     }
 

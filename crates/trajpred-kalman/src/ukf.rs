@@ -2,10 +2,7 @@
 //! ([`MerweSigmaPoints`]) and additive noise, and the unscented RTS smoother.
 
 use crate::error::{KalmanError, Result};
-use crate::filter::{
-    Filter, InputChecks, PredictionWithCross, Smoother, Update, gaussian_log_likelihood,
-    validate_state,
-};
+use crate::filter::{Filter, InputChecks, PredictionWithCross, Smoother, Update, validate_state};
 use crate::linalg::{
     check_dim, check_finite, cholesky, ldl, mul, mul_tr_sym_plus, mul_vec, symmetrise,
 };
@@ -376,19 +373,18 @@ where
         // P - K S K^T, lower triangle mirrored (symmetric)
         let neg_ks = -mul(&gain, &s);
         let cov = mul_tr_sym_plus(&neg_ks, &gain, &prior.covariance);
-        let log_likelihood = gaussian_log_likelihood(&chol, &y);
         check_finite(&mean, "posterior mean")?;
         check_finite(&cov, "posterior covariance")?;
-        Ok(Update {
-            posterior: Gaussian {
+        Ok(Update::new(
+            Gaussian {
                 mean,
                 covariance: cov,
             },
-            innovation: y,
-            innovation_covariance: s,
+            y,
+            &chol,
+            s,
             gain,
-            log_likelihood,
-        })
+        ))
     }
 }
 

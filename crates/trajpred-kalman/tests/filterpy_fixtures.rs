@@ -125,7 +125,7 @@ fn kf_cv_matches_filterpy_step_by_step_with_rts_and_log_likelihood() {
                 close(&u.innovation_covariance, &mat(&e["S"], u2, u2), "S");
                 close(&u.gain, &mat(&e["K"], u4, u2), "K");
                 close_scalar(
-                    u.log_likelihood,
+                    u.log_likelihood(),
                     e["log_likelihood"].as_f64().unwrap(),
                     "ll",
                 );
@@ -227,7 +227,7 @@ fn ekf_range_bearing_matches_filterpy() {
         close(&u.innovation_covariance, &mat(&e["S"], u2, u2), "S");
         close(&u.gain, &mat(&e["K"], u4, u2), "K");
         close_scalar(
-            u.log_likelihood,
+            u.log_likelihood(),
             e["log_likelihood"].as_f64().unwrap(),
             "ll",
         );
@@ -313,7 +313,7 @@ fn ukf_coordinated_turn_60_steps_and_rts_match_filterpy() {
         close(&u.innovation_covariance, &mat(&e["S"], u2, u2), "S");
         close(&u.gain, &mat(&e["K"], u5, u2), "K");
         close_scalar(
-            u.log_likelihood,
+            u.log_likelihood(),
             e["log_likelihood"].as_f64().unwrap(),
             "ll",
         );

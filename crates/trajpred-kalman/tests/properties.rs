@@ -558,7 +558,7 @@ fn augmented_ukf_equals_kf_on_a_linear_model() {
                 "S",
             );
             assert_close(&ua.gain, &uk.gain, 1e-9, "K");
-            assert!((ua.log_likelihood - uk.log_likelihood).abs() < 1e-9);
+            assert!((ua.log_likelihood() - uk.log_likelihood()).abs() < 1e-9);
         }
     }
     assert_eq!(aug.predict(&x0_cv2()).unwrap(), a[0].prior);
@@ -676,7 +676,7 @@ fn selection_update_equals_the_general_update() {
             "S",
         );
         assert_close(&u.gain, &v.gain, 1e-13, "K");
-        assert!((u.log_likelihood - v.log_likelihood).abs() < 1e-12);
+        assert!((u.log_likelihood() - v.log_likelihood()).abs() < 1e-12);
     }
     // a general H is not a selection
     let ob = LinearObservation::new(Matrix1x2::new(1.0, 0.5), Matrix1::new(0.25)).unwrap();
@@ -791,4 +791,31 @@ fn predict_accepts_and_rejects_p_at_every_scale() {
 fn covariance_sqrt_of_zero_is_zero() {
     let z = covariance_sqrt(&Matrix2::<f64>::zeros(), "Q").unwrap();
     assert_eq!(z, Matrix2::zeros());
+}
+
+#[test]
+fn log_likelihood_when_det_s_under_or_overflows() {
+    // H = I, P = 0, R = s I (3 x 3): S = s I, y = (sqrt(s), 0, 0), so NIS = 1 and
+    // ln N(y; 0, S) = -(3 ln 2 pi + 3 ln s + 1) / 2; det S = s^3 underflows (s = 1e-110) or
+    // overflows (s = 1e110) and the log-determinant is then summed over the pivots
+    use nalgebra::{Matrix3, Vector3};
+    for s in [1e-110, 1.0, 1e110] {
+        let tr = LinearTransition::new(Matrix3::<f64>::identity(), Matrix3::zeros()).unwrap();
+        let ob =
+            LinearObservation::new(Matrix3::<f64>::identity(), Matrix3::identity() * s).unwrap();
+        let kf = Kf::new(tr, ob).unwrap();
+        let x = Gaussian {
+            mean: Vector3::zeros(),
+            covariance: Matrix3::zeros(),
+        };
+        let u = kf.update(&x, &Vector3::new(s.sqrt(), 0.0, 0.0)).unwrap();
+        assert!((u.nis - 1.0).abs() < 1e-15, "{s:e}: {}", u.nis);
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let want = -(3.0 * two_pi.ln() + 3.0 * s.ln() + 1.0) / 2.0;
+        let got = u.log_likelihood();
+        assert!(
+            (got - want).abs() <= 1e-12 * want.abs(),
+            "{s:e}: {got} vs {want}"
+        );
+    }
 }
