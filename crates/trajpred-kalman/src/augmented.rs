@@ -269,9 +269,9 @@ impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
         let ob = &self.observation;
         check_dim("observation", ob.observation_dim(), z.nrows())?;
         check_finite(z, "observation")?;
-        let chol = ldl(mo.s.clone(), "S")?;
+        let factors = ldl(mo.s.clone(), "S")?;
         let mut kt = mo.cross.transpose();
-        chol.solve_mut(&mut kt);
+        factors.solve_mut(&mut kt);
         let gain = kt.transpose();
         let y = ob.observation_residual(z, &mo.z_hat);
         let mean = &mo.prior.mean + &gain * &y;
@@ -287,7 +287,7 @@ impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
                     covariance: cov,
                 },
                 y,
-                &chol,
+                &factors,
                 mo.s,
                 gain,
             )),

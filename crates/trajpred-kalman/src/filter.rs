@@ -314,10 +314,10 @@ where
         let mut out: Vec<Gaussian<T, D>> = filtered.to_vec();
         for k in (0..filtered.len().saturating_sub(1)).rev() {
             let (pred, cross) = self.prediction_with_cross_covariance(&filtered[k])?;
-            let chol = ldl(pred.covariance.clone(), "P(k+1|k)")?;
+            let factors = ldl(pred.covariance.clone(), "P(k+1|k)")?;
             // G^T = P(k+1|k)^-1 C^T, since P(k+1|k) is symmetric
             let mut gt = cross.transpose();
-            chol.solve_mut(&mut gt);
+            factors.solve_mut(&mut gt);
             let gain = gt.transpose();
             let next = &out[k + 1];
             let dx = &next.mean - &pred.mean;
@@ -538,10 +538,10 @@ where
         + Allocator<M, D>,
 {
     let p = &prior.covariance;
-    let chol = ldl(s.clone(), "S")?;
+    let factors = ldl(s.clone(), "S")?;
     // K^T = S^-1 H P (P symmetric)
     let mut kt = hp.clone();
-    chol.solve_mut(&mut kt);
+    factors.solve_mut(&mut kt);
     let gain = kt.transpose();
     let y = observation.observation_residual(z, predicted_z);
     let mut mean = mul_vec(&gain, &y);
@@ -560,7 +560,7 @@ where
             covariance: cov,
         },
         y,
-        &chol,
+        &factors,
         s,
         gain,
     );

@@ -246,9 +246,9 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
         let h = self.observation.observation_matrix();
         let p = &prior.covariance;
         let hp = h * p;
-        let chol = ldl(previous.covariance.clone(), "S")?;
+        let factors = ldl(previous.covariance.clone(), "S")?;
         let mut kt = hp.clone();
-        chol.solve_mut(&mut kt);
+        factors.solve_mut(&mut kt);
         let gain = kt.transpose();
         let mean = &prior.mean + &gain * &previous.residual;
         let mut cov = match self.covariance_update {

@@ -70,11 +70,11 @@ impl<Tr, Ob> Kf<Tr, Ob> {
         let hp = h * p;
         let mut s = &hp * h.transpose() + ob.observation_noise();
         symmetrise(&mut s);
-        let chol = ldl(s, "S")?;
+        let factors = ldl(s, "S")?;
         // H P A^T (m x n); K = A P H^T S^-1 = (S^-1 H P A^T)^T
         let hpa = &hp * a.transpose();
         let mut kt = hpa.clone();
-        chol.solve_mut(&mut kt);
+        factors.solve_mut(&mut kt);
         let gain = kt.transpose();
         let innovation = z - h * &prediction.mean;
         let mean = a * &prediction.mean + &gain * innovation;

@@ -87,6 +87,6 @@ where
     let zp = observation.observe(x)?;
     check_dim("h(x)", m, zp.nrows())?;
     let y = observation.observation_residual(z, &zp);
-    let chol = ldl(observation.observation_noise().clone(), "R")?;
-    Ok(gaussian_log_likelihood(&chol, &y))
+    let factors = ldl(observation.observation_noise().clone(), "R")?;
+    Ok(gaussian_log_likelihood(&factors, &y))
 }

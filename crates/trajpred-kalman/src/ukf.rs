@@ -363,9 +363,9 @@ where
         let z_hat = ob.normalize_observation(t.mean);
         let mut s = t.covariance + ob.observation_noise();
         symmetrise(&mut s);
-        let chol = ldl(s.clone(), "S")?;
+        let factors = ldl(s.clone(), "S")?;
         let mut kt = t.cross.transpose();
-        chol.solve_mut(&mut kt);
+        factors.solve_mut(&mut kt);
         let gain = kt.transpose();
         let y = ob.observation_residual(z, &z_hat);
         let mut mean = mul_vec(&gain, &y);
@@ -381,7 +381,7 @@ where
                 covariance: cov,
             },
             y,
-            &chol,
+            &factors,
             s,
             gain,
         ))
