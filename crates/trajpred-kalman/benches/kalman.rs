@@ -95,7 +95,7 @@ fn kf_step(c: &mut Criterion) {
             let s = kf
                 .step(black_box(&state), Some(black_box(&z)))
                 .expect("step");
-            black_box(s.update.map(|u| u.posterior))
+            black_box(&s);
         })
     });
     g.bench_function("trajpred_joseph_cheap_input_checks", |b| {
@@ -103,46 +103,51 @@ fn kf_step(c: &mut Criterion) {
             let s = kf_cheap
                 .step(black_box(&state), Some(black_box(&z)))
                 .expect("step");
-            black_box(s.update.map(|u| u.posterior))
+            black_box(&s);
         })
     });
     g.bench_function("trajpred_predict_only", |b| {
-        b.iter(|| black_box(kf.predict(black_box(&state)).expect("predict")))
+        b.iter(|| {
+            let prior = kf.predict(black_box(&state)).expect("predict");
+            black_box(&prior);
+        })
     });
     g.bench_function("trajpred_update_only", |b| {
         b.iter(|| {
-            black_box(
-                kf.update_predicted(black_box(&state), black_box(&z))
-                    .expect("update"),
-            )
+            let update = kf
+                .update_predicted(black_box(&state), black_box(&z))
+                .expect("update");
+            black_box(&update);
         })
     });
     g.bench_function("adskalman_predict_only", |b| {
-        b.iter(|| black_box(ads_tr.predict(black_box(&ads_state))))
+        b.iter(|| {
+            let prior = ads_tr.predict(black_box(&ads_state));
+            black_box(&prior);
+        })
     });
     g.bench_function("adskalman_update_only", |b| {
         b.iter(|| {
-            black_box(
-                ads_ob
-                    .update(
-                        black_box(&ads_state),
-                        black_box(&z),
-                        CovarianceUpdateMethod::JosephForm,
-                    )
-                    .expect("update"),
-            )
-        })
-    });
-    g.bench_function("adskalman_joseph", |b| {
-        b.iter(|| {
-            black_box(
-                ads.step_with_options(
+            let posterior = ads_ob
+                .update(
                     black_box(&ads_state),
                     black_box(&z),
                     CovarianceUpdateMethod::JosephForm,
                 )
-                .expect("step"),
-            )
+                .expect("update");
+            black_box(&posterior);
+        })
+    });
+    g.bench_function("adskalman_joseph", |b| {
+        b.iter(|| {
+            let posterior = ads
+                .step_with_options(
+                    black_box(&ads_state),
+                    black_box(&z),
+                    CovarianceUpdateMethod::JosephForm,
+                )
+                .expect("step");
+            black_box(&posterior);
         })
     });
     g.finish();
@@ -164,7 +169,7 @@ fn ukf_step(c: &mut Criterion) {
             let s = ukf
                 .step(black_box(&state), Some(black_box(&z)))
                 .expect("step");
-            black_box(s.update.map(|u| u.posterior))
+            black_box(&s);
         })
     });
     g.finish();

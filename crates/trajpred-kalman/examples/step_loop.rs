@@ -125,26 +125,26 @@ fn main() {
                 let s = kf
                     .step(black_box(&state), Some(black_box(&z)))
                     .expect("step");
-                black_box(s.update.map(|u| u.posterior));
+                black_box(&s);
             }
             "kf_cheap" => {
                 let s = kf_cheap
                     .step(black_box(&state), Some(black_box(&z)))
                     .expect("step");
-                black_box(s.update.map(|u| u.posterior));
+                black_box(&s);
             }
             "kf_predict" => {
-                black_box(kf.predict(black_box(&state)).expect("predict"));
+                black_box(&kf.predict(black_box(&state)).expect("predict"));
             }
             "kf_update" => {
                 black_box(
-                    kf.update_predicted(black_box(&state), black_box(&z))
+                    &kf.update_predicted(black_box(&state), black_box(&z))
                         .expect("update"),
                 );
             }
             "ads" => {
                 black_box(
-                    ads.step_with_options(
+                    &ads.step_with_options(
                         black_box(&ads_state),
                         black_box(&z),
                         CovarianceUpdateMethod::JosephForm,
@@ -153,11 +153,11 @@ fn main() {
                 );
             }
             "ads_predict" => {
-                black_box(ads_tr.predict(black_box(&ads_state)));
+                black_box(&ads_tr.predict(black_box(&ads_state)));
             }
             "ads_update" => {
                 black_box(
-                    ads_ob
+                    &ads_ob
                         .update(
                             black_box(&ads_state),
                             black_box(&z),
@@ -170,20 +170,20 @@ fn main() {
                 let s = ukf
                     .step(black_box(&ustate), Some(black_box(&uz)))
                     .expect("step");
-                black_box(s.update.map(|u| u.posterior));
+                black_box(&s);
             }
             "ukf_corr" => {
                 let s = ukf
                     .step(black_box(&ustate_corr), Some(black_box(&uz)))
                     .expect("step");
-                black_box(s.update.map(|u| u.posterior));
+                black_box(&s);
             }
             "ukf_predict" => {
-                black_box(ukf.predict(black_box(&ustate)).expect("predict"));
+                black_box(&ukf.predict(black_box(&ustate)).expect("predict"));
             }
             "ukf_update" => {
                 black_box(
-                    ukf.update_predicted(black_box(&ustate), black_box(&uz))
+                    &ukf.update_predicted(black_box(&ustate), black_box(&uz))
                         .expect("update"),
                 );
             }

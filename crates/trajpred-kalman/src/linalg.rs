@@ -575,6 +575,9 @@ where
 /// largest diagonal element (for a positive definite matrix the largest magnitude is on the
 /// diagonal). A non-finite upper element fails the symmetry test (the tolerance is finite
 /// whenever the factorisation succeeded), so no separate finiteness pass over `P` is needed.
+/// An exactly symmetric `P` (every output of the filters, whose covariances are mirrored)
+/// skips the tolerance: equal triangles need no scale, and a non-finite upper element can
+/// only equal an infinite lower one (NaN equals nothing), which the factorisation rejects.
 #[inline(always)]
 pub(crate) fn mean_finite_and_symmetric<T, D>(state: &Gaussian<T, D>) -> bool
 where
@@ -583,6 +586,15 @@ where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     let p = &state.covariance;
+    let mut exact = true;
+    for j in 0..p.nrows() {
+        for i in 0..j {
+            exact &= p[(i, j)] == p[(j, i)];
+        }
+    }
+    if exact {
+        return all_finite(&state.mean);
+    }
     let mut scale = T::zero();
     for j in 0..p.nrows() {
         let v = p[(j, j)];

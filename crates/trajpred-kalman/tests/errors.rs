@@ -192,6 +192,45 @@ fn not_positive_definite_p_q_r_s() {
 }
 
 #[test]
+fn kf_predict_checks_the_symmetry_of_p() {
+    // the static-size KF with a structured F: an exactly symmetric P takes the fast path,
+    // a P symmetric to within sqrt(eps) of its largest diagonal element is accepted, any
+    // other P is rejected, including one whose two triangles hold the same non-finite value
+    let (tr, ob) = cv();
+    let kf = Kf::new(&tr, &ob).unwrap();
+    let mut x = state();
+    x.covariance = Matrix4::from_fn(|i, j| if i == j { 2.0 } else { 0.25 });
+    let exact = kf.predict(&x).unwrap();
+    let mut near = x.clone();
+    near.covariance[(0, 1)] += 1e-10;
+    let got = kf.predict(&near).unwrap();
+    assert!((got.covariance - exact.covariance).amax() < 1e-9);
+    assert_eq!(got.covariance, got.covariance.transpose());
+    for (i, j, v) in [
+        (0, 1, 0.5),
+        (1, 3, -0.25),
+        (2, 3, f64::NAN),
+        (0, 2, f64::INFINITY),
+    ] {
+        let mut bad = x.clone();
+        bad.covariance[(i, j)] = v;
+        let expected = |r: &Result<Gaussian<f64, U4>, KalmanError>| {
+            if v.is_finite() {
+                matches!(r, Err(KalmanError::NotPositiveDefinite { what: "P" }))
+            } else {
+                matches!(r, Err(KalmanError::NonFinite { what: "P", .. }))
+            }
+        };
+        assert!(expected(&kf.predict(&bad)), "upper ({i}, {j}) = {v}");
+        if !v.is_finite() {
+            // symmetric, but not finite
+            bad.covariance[(j, i)] = v;
+            assert!(expected(&kf.predict(&bad)), "both ({i}, {j}) = {v}");
+        }
+    }
+}
+
+#[test]
 fn s_not_positive_definite_inside_an_update() {
     // A user observation model whose R is validated but whose Jacobian returns NaN-free
     // values that overflow S: S = H P H^T + R is then not finite -> not positive definite.
