@@ -368,6 +368,30 @@ where
         let big = T::max_value().unwrap_or(T::one() / T::zero());
         let mut d = OVector::<T, D>::zeros_generic(dd, Const::<1>);
         let mut inv_d = OVector::<T, D>::zeros_generic(dd, Const::<1>);
+        if n == 2 {
+            // the 2 x 2 case in closed form: `d_1 = det / a_00` with `det = a_00 a_11 - a_10^2`,
+            // so the two divisions (by `a_00` and by `det`) run side by side instead of the
+            // second waiting for the first. Taken when `det` is a normal number and every
+            // factor is finite; otherwise (a product under- or overflowed, or the matrix is
+            // not positive definite) the loop below decides.
+            let (a00, a10, a11) = (a[(0, 0)] + shift, a[(1, 0)], a[(1, 1)] + shift);
+            let det = a00 * a11 - a10 * a10;
+            let (inv0, inv_det) = (T::one() / a00, T::one() / det);
+            let (d1, inv1) = (det * inv0, a00 * inv_det);
+            // 4 / max is the smallest normal number (max = (2 - 2^-p) 2^e_max)
+            let min_normal = nalgebra::convert::<f64, T>(4.0) / big;
+            // (then 1 / a_00 is finite too)
+            let normal = |v: T| (v >= min_normal) & (v <= big);
+            if normal(a00) & normal(det) & (d1 > T::zero()) & (d1 <= big) & (inv1 <= big) {
+                d[0] = a00;
+                d[1] = d1;
+                inv_d[0] = inv0;
+                inv_d[1] = inv1;
+                a[(0, 1)] = a10;
+                a[(1, 0)] = a10 * inv0;
+                return (Ldl { l: a, d, inv_d }, true);
+            }
+        }
         let mut ok = true;
         for j in 0..n {
             // row j of L is in a[(j, k)], k < j; w_k = L_jk d_k goes to the unused a[(k, j)]

@@ -819,3 +819,59 @@ fn log_likelihood_when_det_s_under_or_overflows() {
         );
     }
 }
+
+#[test]
+fn two_by_two_innovation_covariance_at_every_scale() {
+    // H = I, P = s I, R = s [[2, 1], [1, 2]]: S = s [[3, 1], [1, 3]], worked by hand:
+    // K = P S^-1 = [[3, -1], [-1, 3]] / 8 at every scale, posterior covariance
+    // (I - K) P = s [[5, 1], [1, 5]] / 8, and for y = sqrt(s) (1, 2) the NIS is
+    // (3 - 4 + 12) / 8 = 11 / 8 and ln N(y; 0, S) = -(2 ln 2 pi + ln 8 + 2 ln s + 11 / 8) / 2.
+    // det S = 8 s^2 is a normal number for s = 1e-100 .. 1e100 (the closed-form 2 x 2
+    // factors) and sub-normal (s = 1e-160) or infinite (s = 1e160) otherwise (the general
+    // elimination); every scale gives the same relative figures.
+    use nalgebra::Matrix2;
+    for s in [1e-160, 1e-100, 1e-3, 1.0, 1e3, 1e100, 1e160] {
+        let tr = LinearTransition::new(Matrix2::<f64>::identity(), Matrix2::zeros()).unwrap();
+        let ob = LinearObservation::new(
+            Matrix2::<f64>::identity(),
+            Matrix2::new(2.0, 1.0, 1.0, 2.0) * s,
+        )
+        .unwrap();
+        let kf = Kf::new(tr, ob).unwrap();
+        let x = Gaussian {
+            mean: Vector2::zeros(),
+            covariance: Matrix2::identity() * s,
+        };
+        let z = Vector2::new(1.0, 2.0) * s.sqrt();
+        let u = kf.update(&x, &z).unwrap();
+        let k = Matrix2::new(3.0, -1.0, -1.0, 3.0) / 8.0;
+        assert!((u.gain - k).amax() < 1e-15, "{s:e}: K {}", u.gain);
+        let post = Matrix2::new(5.0, 1.0, 1.0, 5.0) / 8.0;
+        assert!(
+            (u.posterior.covariance / s - post).amax() < 1e-15,
+            "{s:e}: P {}",
+            u.posterior.covariance
+        );
+        assert!((u.nis - 11.0 / 8.0).abs() < 1e-15, "{s:e}: NIS {}", u.nis);
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let want = -(2.0 * two_pi.ln() + 8f64.ln() + 2.0 * s.ln() + 11.0 / 8.0) / 2.0;
+        let got = u.log_likelihood();
+        assert!(
+            (got - want).abs() <= 1e-13 * want.abs().max(1.0),
+            "{s:e}: {got} vs {want}"
+        );
+    }
+    // a prior whose S = H P H^T + R is indefinite (update_predicted skips the check of P):
+    // P = [[1, 3], [3, 1]] (eigenvalues 4 and -2), R = I / 10
+    let tr = LinearTransition::new(Matrix2::<f64>::identity(), Matrix2::zeros()).unwrap();
+    let ob = LinearObservation::new(Matrix2::<f64>::identity(), Matrix2::identity() * 0.1).unwrap();
+    let kf = Kf::new(tr, ob).unwrap();
+    let bad = Gaussian {
+        mean: Vector2::zeros(),
+        covariance: Matrix2::new(1.0, 3.0, 3.0, 1.0),
+    };
+    assert!(matches!(
+        kf.update_predicted(&bad, &Vector2::zeros()),
+        Err(KalmanError::NotPositiveDefinite { what: "S" })
+    ));
+}
