@@ -150,8 +150,9 @@ where
 /// `S = H P H^T + R` (symmetric), for any gain `K`. Expanding the product gives
 /// `P - K (HP) - (HP)^T K^T + K S K^T`, which equals `P + U K^T + K U^T` with
 /// `U = K S / 2 - (HP)^T` (an `n x m` matrix): for static sizes only the lower triangle of
-/// that sum is formed (with `(P + P^T) / 2`) and mirrored, so the result is exactly
-/// symmetric; run-time sizes use nalgebra's products and [`symmetrise`].
+/// that sum is formed (from the lower triangle of `P`, which is symmetric: exactly for the
+/// filters' own predictions, to the input check's tolerance otherwise) and mirrored, so the
+/// result is exactly symmetric; run-time sizes use nalgebra's products and [`symmetrise`].
 #[inline(always)]
 pub(crate) fn joseph<T, D, M>(
     p: &OMatrix<T, D, D>,
@@ -174,7 +175,7 @@ where
         // lower triangle, column by column with i innermost (contiguous): vectorises
         for j in 0..d.value() {
             for i in j..d.value() {
-                out[(i, j)] = (p[(i, j)] + p[(j, i)]) * half;
+                out[(i, j)] = p[(i, j)];
             }
             for a in 0..m.value() {
                 let (kja, uja) = (k[(j, a)], u[(j, a)]);
@@ -572,6 +573,36 @@ where
     })
 }
 
+/// `true` when the two triangles of `m` are equal element for element (NaN equals nothing):
+/// the filters' own covariances are, being mirrored, and then no tolerance (and no scale for
+/// it) is needed.
+#[inline(always)]
+fn exactly_symmetric<T, D>(m: &OMatrix<T, D, D>) -> bool
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D>,
+{
+    let mut exact = true;
+    for j in 0..m.nrows() {
+        for i in 0..j {
+            exact &= m[(i, j)] == m[(j, i)];
+        }
+    }
+    exact
+}
+
+/// A non-negative diagonal.
+#[inline(always)]
+fn nonnegative_diagonal<T, D>(m: &OMatrix<T, D, D>) -> bool
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D>,
+{
+    (0..m.nrows()).fold(true, |ok, j| ok & (m[(j, j)] >= T::zero()))
+}
+
 /// Symmetric to [`symmetry_tolerance`] of `scale = max|m|`, with a non-negative diagonal
 /// (branch-free).
 #[inline(always)]
@@ -610,13 +641,7 @@ where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     let p = &state.covariance;
-    let mut exact = true;
-    for j in 0..p.nrows() {
-        for i in 0..j {
-            exact &= p[(i, j)] == p[(j, i)];
-        }
-    }
-    if exact {
+    if exactly_symmetric(p) {
         return all_finite(&state.mean);
     }
     let mut scale = T::zero();
@@ -756,7 +781,9 @@ where
         && (if full {
             is_psd(p)
         } else {
-            all_finite(p) && is_symmetric_with_nonnegative_diagonal(p, amax_finite(p))
+            all_finite(p)
+                && ((exactly_symmetric(p) && nonnegative_diagonal(p))
+                    || is_symmetric_with_nonnegative_diagonal(p, amax_finite(p)))
         })
     {
         return Ok(());

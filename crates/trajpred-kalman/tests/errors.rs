@@ -9,7 +9,7 @@ use trajpred_kalman::motion::{
     KinematicLayout, StateOrder, constant_velocity, position_observation,
 };
 use trajpred_kalman::{
-    CoordinatedTurn, Ekf, Filter, Ikf, Innovation, KalmanError, Kf, LinearObservation,
+    CoordinatedTurn, Ekf, Filter, Ikf, Innovation, InputChecks, KalmanError, Kf, LinearObservation,
     LinearTransition, MerweSigmaPoints, RangeBearing, Smoother, Ukf,
 };
 
@@ -193,40 +193,52 @@ fn not_positive_definite_p_q_r_s() {
 
 #[test]
 fn kf_predict_checks_the_symmetry_of_p() {
-    // the static-size KF with a structured F: an exactly symmetric P takes the fast path,
-    // a P symmetric to within sqrt(eps) of its largest diagonal element is accepted, any
-    // other P is rejected, including one whose two triangles hold the same non-finite value
+    // the static-size KF with a structured F, with either input check: an exactly symmetric
+    // P takes the fast path, a P symmetric to within sqrt(eps) of its largest diagonal
+    // element is accepted, any other P is rejected, including one whose two triangles hold
+    // the same non-finite value
     let (tr, ob) = cv();
-    let kf = Kf::new(&tr, &ob).unwrap();
-    let mut x = state();
-    x.covariance = Matrix4::from_fn(|i, j| if i == j { 2.0 } else { 0.25 });
-    let exact = kf.predict(&x).unwrap();
-    let mut near = x.clone();
-    near.covariance[(0, 1)] += 1e-10;
-    let got = kf.predict(&near).unwrap();
-    assert!((got.covariance - exact.covariance).amax() < 1e-9);
-    assert_eq!(got.covariance, got.covariance.transpose());
-    for (i, j, v) in [
-        (0, 1, 0.5),
-        (1, 3, -0.25),
-        (2, 3, f64::NAN),
-        (0, 2, f64::INFINITY),
-    ] {
-        let mut bad = x.clone();
-        bad.covariance[(i, j)] = v;
-        let expected = |r: &Result<Gaussian<f64, U4>, KalmanError>| {
-            if v.is_finite() {
-                matches!(r, Err(KalmanError::NotPositiveDefinite { what: "P" }))
-            } else {
-                matches!(r, Err(KalmanError::NonFinite { what: "P", .. }))
+    for checks in [InputChecks::Full, InputChecks::Cheap] {
+        let kf = Kf::new(&tr, &ob).unwrap().with_input_checks(checks);
+        let mut x = state();
+        x.covariance = Matrix4::from_fn(|i, j| if i == j { 2.0 } else { 0.25 });
+        let exact = kf.predict(&x).unwrap();
+        let mut near = x.clone();
+        near.covariance[(0, 1)] += 1e-10;
+        let got = kf.predict(&near).unwrap();
+        assert!((got.covariance - exact.covariance).amax() < 1e-9);
+        assert_eq!(got.covariance, got.covariance.transpose());
+        for (i, j, v) in [
+            (0, 1, 0.5),
+            (1, 3, -0.25),
+            (2, 3, f64::NAN),
+            (0, 2, f64::INFINITY),
+        ] {
+            let mut bad = x.clone();
+            bad.covariance[(i, j)] = v;
+            let expected = |r: &Result<Gaussian<f64, U4>, KalmanError>| {
+                if v.is_finite() {
+                    matches!(r, Err(KalmanError::NotPositiveDefinite { what: "P" }))
+                } else {
+                    matches!(r, Err(KalmanError::NonFinite { what: "P", .. }))
+                }
+            };
+            let r = kf.predict(&bad);
+            assert!(expected(&r), "{checks:?}: upper ({i}, {j}) = {v}: {r:?}");
+            if !v.is_finite() {
+                // symmetric, but not finite
+                bad.covariance[(j, i)] = v;
+                let r = kf.predict(&bad);
+                assert!(expected(&r), "{checks:?}: both ({i}, {j}) = {v}: {r:?}");
             }
-        };
-        assert!(expected(&kf.predict(&bad)), "upper ({i}, {j}) = {v}");
-        if !v.is_finite() {
-            // symmetric, but not finite
-            bad.covariance[(j, i)] = v;
-            assert!(expected(&kf.predict(&bad)), "both ({i}, {j}) = {v}");
         }
+        // a negative variance with exactly symmetric triangles
+        let mut negative = x.clone();
+        negative.covariance[(3, 3)] = -1.0;
+        assert!(matches!(
+            kf.predict(&negative),
+            Err(KalmanError::NotPositiveDefinite { what: "P" })
+        ));
     }
 }
 
