@@ -214,15 +214,43 @@ where
         Ok(prior)
     }
 
+    /// [`Filter::predict`] (or [`Filter::predict_own_output`] when `own_output`), then
+    /// [`Filter::update_predicted`] of that prediction by `z`: the work of an observed step
+    /// of [`Filter::step`] and [`Filter::filter`]. A filter may fuse the two calls (the KF
+    /// checks the prediction's finiteness through its update's); the results and the errors
+    /// are those of the two calls.
+    #[inline(always)]
+    fn predict_update(
+        &self,
+        state: &Gaussian<T, D>,
+        z: &OVector<T, M>,
+        own_output: bool,
+    ) -> Result<(Gaussian<T, D>, Update<T, D, M>)> {
+        let prior = if own_output {
+            self.predict_own_output(state)?
+        } else {
+            self.predict(state)?
+        };
+        let update = self.update_predicted(&prior, z)?;
+        Ok((prior, update))
+    }
+
     /// Predict, then update when `z` is `Some` (a missing observation is `None`).
     #[inline(always)]
     fn step(&self, state: &Gaussian<T, D>, z: Option<&OVector<T, M>>) -> Result<Step<T, D, M>> {
-        let prior = self.predict(state)?;
-        let update = match z {
-            Some(z) => Some(self.update_predicted(&prior, z)?),
-            None => None,
-        };
-        Ok(Step { prior, update })
+        match z {
+            Some(z) => {
+                let (prior, update) = self.predict_update(state, z, false)?;
+                Ok(Step {
+                    prior,
+                    update: Some(update),
+                })
+            }
+            None => Ok(Step {
+                prior: self.predict(state)?,
+                update: None,
+            }),
+        }
     }
 
     /// Runs [`Filter::step`] over a sequence of observations starting from `initial` (the
@@ -234,16 +262,19 @@ where
     ) -> Result<Vec<Step<T, D, M>>> {
         let mut out: Vec<Step<T, D, M>> = Vec::with_capacity(observations.len());
         for z in observations {
-            let step = match out.last() {
-                Some(prev) => {
-                    let prior = self.predict_own_output(prev.posterior())?;
-                    let update = match z {
-                        Some(z) => Some(self.update_predicted(&prior, z)?),
-                        None => None,
-                    };
-                    Step { prior, update }
+            let step = match (out.last(), z) {
+                (Some(prev), Some(z)) => {
+                    let (prior, update) = self.predict_update(prev.posterior(), z, true)?;
+                    Step {
+                        prior,
+                        update: Some(update),
+                    }
                 }
-                None => self.step(initial, z.as_ref())?,
+                (Some(prev), None) => Step {
+                    prior: self.predict_own_output(prev.posterior())?,
+                    update: None,
+                },
+                (None, z) => self.step(initial, z.as_ref())?,
             };
             out.push(step);
         }
@@ -396,6 +427,43 @@ where
     Tr: LinearTransitionModel<T, D> + ?Sized,
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
+    let prior = linear_predict_unchecked_output(tr, state, n, factorise, checks)?;
+    check_prediction(&prior)?;
+    Ok(prior)
+}
+
+/// A prediction's mean and covariance are finite, or [`KalmanError::NonFinite`] naming the
+/// first that is not (one branch; the element is located only on failure).
+#[inline(always)]
+pub(crate) fn check_prediction<T, D>(prior: &Gaussian<T, D>) -> Result<()>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    if !(all_finite(&prior.mean) & all_finite(&prior.covariance)) {
+        check_finite(&prior.mean, "predicted mean")?;
+        check_finite(&prior.covariance, "predicted covariance")?;
+    }
+    Ok(())
+}
+
+/// [`linear_predict`] without the finiteness check of its result (its input checks are
+/// all made), for a caller that proves the result finite otherwise.
+#[inline(always)]
+pub(crate) fn linear_predict_unchecked_output<T, D, Tr>(
+    tr: &Tr,
+    state: &Gaussian<T, D>,
+    n: usize,
+    factorise: bool,
+    checks: InputChecks,
+) -> Result<Gaussian<T, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    Tr: LinearTransitionModel<T, D> + ?Sized,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
     let f = tr.transition_matrix();
     if factorise && is_static::<D, D>() {
         check_dim("state mean", n, state.mean.nrows())?;
@@ -411,13 +479,8 @@ where
             congruence_ldl(f, &state.covariance, tr.process_noise()).filter(|_| fast_ok)
         };
         if let Some(p) = p {
-            let mean = tr.propagate_mean(&state.mean);
-            if !(all_finite(&mean) & all_finite(&p)) {
-                check_finite(&mean, "predicted mean")?;
-                check_finite(&p, "predicted covariance")?;
-            }
             return Ok(Gaussian {
-                mean,
+                mean: tr.propagate_mean(&state.mean),
                 covariance: p,
             });
         }
@@ -425,13 +488,9 @@ where
     validate_state(state, n, checks)?;
     check_dim("F rows", n, f.nrows())?;
     check_dim("F columns", n, f.ncols())?;
-    let mean = tr.propagate_mean(&state.mean);
-    let p = tr.propagate_covariance(&state.covariance);
-    check_finite(&mean, "predicted mean")?;
-    check_finite(&p, "predicted covariance")?;
     Ok(Gaussian {
-        mean,
-        covariance: p,
+        mean: tr.propagate_mean(&state.mean),
+        covariance: tr.propagate_covariance(&state.covariance),
     })
 }
 

@@ -4,10 +4,11 @@
 
 use crate::error::Result;
 use crate::filter::{
-    CovarianceUpdate, Filter, InputChecks, PredictionWithCross, Smoother, Update, finish_update,
-    linear_predict, linearized_predict, linearized_update, selection_products, validate_state,
+    CovarianceUpdate, Filter, InputChecks, PredictionWithCross, Smoother, Update, check_prediction,
+    finish_update, linear_predict, linear_predict_unchecked_output, linearized_predict,
+    linearized_update, selection_products, validate_state,
 };
-use crate::linalg::{check_dim, check_finite, mul_vec};
+use crate::linalg::{check_dim, check_finite, exactly_symmetric, mul_vec};
 use crate::model::{
     LinearObservationModel, LinearTransitionModel, ObservationJacobian, TransitionJacobian,
     validate_models,
@@ -143,6 +144,45 @@ where
     fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>> {
         validate_state(prior, self.transition.state_dim(), self.checks)?;
         self.update_predicted(prior, z)
+    }
+
+    /// The prediction's finiteness is proven by the update's: every element of the prior
+    /// enters the same element of the posterior with coefficient 1 (`x + K y`, and
+    /// `P + U K^T + K U^T` from the lower triangle of `P` or `P - K H P`), so a finite
+    /// posterior and an exactly symmetric prior covariance prove the prior finite. The
+    /// prior is checked itself only when the update fails or the prior is not exactly
+    /// symmetric, so the errors are those of `predict` then `update_predicted`.
+    #[inline(always)]
+    fn predict_update(
+        &self,
+        state: &Gaussian<T, D>,
+        z: &OVector<T, M>,
+        own_output: bool,
+    ) -> Result<(Gaussian<T, D>, Update<T, D, M>)> {
+        let checks = if own_output {
+            InputChecks::Cheap
+        } else {
+            self.checks
+        };
+        let prior = linear_predict_unchecked_output(
+            &self.transition,
+            state,
+            self.transition.state_dim(),
+            self.checks == InputChecks::Full,
+            checks,
+        )?;
+        match self.update_predicted(&prior, z) {
+            Ok(update) => {
+                if !exactly_symmetric(&prior.covariance) {
+                    check_prediction(&prior)?;
+                }
+                Ok((prior, update))
+            }
+            Err(e) => {
+                check_prediction(&prior)?;
+                Err(e)
+            }
+        }
     }
 
     #[inline(always)]

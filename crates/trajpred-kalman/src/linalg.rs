@@ -577,7 +577,7 @@ where
 /// the filters' own covariances are, being mirrored, and then no tolerance (and no scale for
 /// it) is needed.
 #[inline(always)]
-fn exactly_symmetric<T, D>(m: &OMatrix<T, D, D>) -> bool
+pub(crate) fn exactly_symmetric<T, D>(m: &OMatrix<T, D, D>) -> bool
 where
     T: RealField + Copy,
     D: Dim,

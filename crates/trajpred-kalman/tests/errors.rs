@@ -243,6 +243,48 @@ fn kf_predict_checks_the_symmetry_of_p() {
 }
 
 #[test]
+fn a_step_reports_the_errors_of_its_prediction_first() {
+    // the KF's step checks its prediction through the update (a finite posterior proves the
+    // prior finite); the errors must still be those of predict, then update
+    let (tr, ob) = cv();
+    let kf = Kf::new(&tr, &ob).unwrap();
+    let z = Vector2::new(1.0, 2.0);
+    // the predicted covariance overflows (P_00 + dt^2 P_11 > max)
+    let mut huge = state();
+    huge.covariance = Matrix4::identity() * 1.7e308;
+    // the predicted mean overflows (x + dt v > max)
+    let mut fast = state();
+    fast.mean = Vector4::new(1.7e308, 1.7e308, 0.0, 0.0);
+    for (x, what) in [(huge, "predicted covariance"), (fast, "predicted mean")] {
+        let want =
+            |r: &KalmanError| matches!(r, KalmanError::NonFinite { what: w, .. } if *w == what);
+        let e = kf.predict(&x).unwrap_err();
+        assert!(want(&e), "predict: {e:?}");
+        let e = kf.step(&x, Some(&z)).unwrap_err();
+        assert!(want(&e), "step: {e:?}");
+        let e = kf.filter(&x, &[Some(z)]).unwrap_err();
+        assert!(want(&e), "filter: {e:?}");
+        // with a bad observation as well, the prediction's error still comes first
+        let e = kf.step(&x, Some(&Vector2::new(f64::NAN, 0.0))).unwrap_err();
+        assert!(want(&e), "step, NaN observation: {e:?}");
+    }
+    // a finite prediction and a bad observation: the observation's error
+    let e = kf
+        .step(&state(), Some(&Vector2::new(f64::NAN, 0.0)))
+        .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            KalmanError::NonFinite {
+                what: "observation",
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+}
+
+#[test]
 fn s_not_positive_definite_inside_an_update() {
     // A user observation model whose R is validated but whose Jacobian returns NaN-free
     // values that overflow S: S = H P H^T + R is then not finite -> not positive definite.
