@@ -225,7 +225,7 @@ where
         state: &Gaussian<T, D>,
         z: &OVector<T, M>,
         own_output: bool,
-    ) -> Result<(Gaussian<T, D>, Update<T, D, M>)> {
+    ) -> Result<PredictionAndUpdate<T, D, M>> {
         let prior = if own_output {
             self.predict_own_output(state)?
         } else {
@@ -308,6 +308,9 @@ where
         Ok(out)
     }
 }
+
+/// A prediction and its update by an observation ([`Filter::predict_update`]).
+pub type PredictionAndUpdate<T, D, M> = (Gaussian<T, D>, Update<T, D, M>);
 
 /// A prediction `N(x(k+1|k), P(k+1|k))` with the cross-covariance `Cov(x(k), x(k+1))`.
 pub type PredictionWithCross<T, D> = (Gaussian<T, D>, OMatrix<T, D, D>);

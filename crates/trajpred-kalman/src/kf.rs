@@ -4,9 +4,9 @@
 
 use crate::error::Result;
 use crate::filter::{
-    CovarianceUpdate, Filter, InputChecks, PredictionWithCross, Smoother, Update, check_prediction,
-    finish_update, linear_predict, linear_predict_unchecked_output, linearized_predict,
-    linearized_update, selection_products, validate_state,
+    CovarianceUpdate, Filter, InputChecks, PredictionAndUpdate, PredictionWithCross, Smoother,
+    Update, check_prediction, finish_update, linear_predict, linear_predict_unchecked_output,
+    linearized_predict, linearized_update, selection_products, validate_state,
 };
 use crate::linalg::{check_dim, check_finite, exactly_symmetric, mul_vec};
 use crate::model::{
@@ -158,7 +158,7 @@ where
         state: &Gaussian<T, D>,
         z: &OVector<T, M>,
         own_output: bool,
-    ) -> Result<(Gaussian<T, D>, Update<T, D, M>)> {
+    ) -> Result<PredictionAndUpdate<T, D, M>> {
         let checks = if own_output {
             InputChecks::Cheap
         } else {

@@ -109,7 +109,8 @@ pub mod model;
 
 pub use error::{KalmanError, Result};
 pub use filter::{
-    CovarianceUpdate, Filter, InputChecks, PredictionWithCross, Smoother, Step, Update,
+    CovarianceUpdate, Filter, InputChecks, PredictionAndUpdate, PredictionWithCross, Smoother,
+    Step, Update,
 };
 pub use kf::{Ekf, Kf};
 pub use model::{
