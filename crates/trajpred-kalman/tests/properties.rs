@@ -639,6 +639,24 @@ fn structured_propagation_equals_the_dense_products() {
             }
         }
     }
+    // a unit-diagonal F whose row updates cannot run in place (the update of row 0 reads row
+    // 1, which an earlier entry updates): the structured path with a copy
+    let coupled = LinearTransition::new(
+        Matrix2::new(1.0, 0.3, 0.2, 1.0),
+        Matrix2::new(0.5, 0.1, 0.1, 0.4),
+    )
+    .unwrap();
+    assert!(coupled.has_structured_propagation());
+    let p = Matrix2::new(2.0, -0.7, -0.7, 1.5);
+    let (f, q) = (coupled.f(), coupled.q());
+    let got = coupled.propagate_covariance(&p);
+    assert_close(
+        &got,
+        &(f * p * f.transpose() + q),
+        1e-14,
+        "coupled F P F^T + Q",
+    );
+    assert_eq!(got, got.transpose(), "exactly symmetric");
     // a general F keeps the dense products
     let dense =
         LinearTransition::new(Matrix2::new(0.9, 0.1, -0.2, 1.0), Matrix2::identity()).unwrap();
