@@ -1,6 +1,8 @@
-//! Wall-clock and thread CPU time (from /proc/thread-self/schedstat, Linux) of the four
-//! resamplers on i.i.d. uniform linear weights, for a shared machine where cri(on)
-//! wall-clock figures include time the thread spent descheduled. Usage:
+//! Wall-clock and CPU time (of every thread of the process, from
+//! /proc/self/task/*/schedstat, Linux) of the four resamplers on i.i.d. uniform linear
+//! weights, for a shared machine where criterion's wall-clock figures include time the
+//! threads spent descheduled; after each scheme, a hash of its last output, to compare the
+//! indices of two builds (same `N` and `REPS`, so the same draws). Usage:
 //! `cargo run --release -p trajpred-particle --example resample_cpu_time -- N REPS`
 //! (`EXPT=1`: cost of one Exp(1) / one uniform draw with a running sum; `SCHEME=name`: only
 //! that scheme, e.g. for `perf record`).
@@ -8,15 +10,17 @@ use rand::rngs::SmallRng;
 use rand::{RngExt, SeedableRng};
 use std::hint::black_box;
 use std::time::Instant;
+/// CPU seconds of every thread of this process so far.
 fn cpu() -> f64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .unwrap()
-        .split_whitespace()
-        .next()
-        .unwrap()
-        .parse::<f64>()
-        .unwrap()
-        * 1e-9
+    let mut ns = 0.0;
+    for task in std::fs::read_dir("/proc/self/task").unwrap() {
+        let path = task.unwrap().path().join("schedstat");
+        // a thread may have exited since the directory was read
+        if let Ok(s) = std::fs::read_to_string(path) {
+            ns += s.split_whitespace().next().unwrap().parse::<f64>().unwrap();
+        }
+    }
+    ns * 1e-9
 }
 use trajpred_particle::{Resampler, Resampling};
 fn main() {
@@ -59,8 +63,11 @@ fn main() {
             }
             let dt = t.elapsed().as_secs_f64() / reps as f64;
             let dc = (cpu() - c0) / reps as f64;
+            let hash = out.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &i| {
+                (h ^ i as u64).wrapping_mul(0x0100_0000_01b3)
+            });
             eprintln!(
-                "{:12} {:8.2} ns/p {:8.1} M/s   cpu {:8.2} ns/p {:8.1} M/s",
+                "{:12} {:8.2} ns/p {:8.1} M/s   cpu {:8.2} ns/p {:8.1} M/s   hash {hash:016x}",
                 scheme.name(),
                 dt * 1e9 / n as f64,
                 n as f64 / dt / 1e6,

@@ -739,21 +739,21 @@ struct ResidualSums {
 }
 
 /// `(floor(x), x - floor(x))` for `x = w scale`, `0 <= x < 2^51`, without a conversion
-/// instruction (Rust's saturating `as` costs a compare and a branch per value): `x - 1/2` is
-/// rounded to an integer by adding [`ROUND`] (exact for `x >= 1/4`, and below that any
-/// rounding stays in `[-1/2, 1/2)`), which is `floor(x)` except for an odd integer `x`
-/// (half to even rounds down), where the fractional part comes out as 1 and is corrected.
+/// instruction (Rust's saturating `as` costs a compare and a branch per value) and without
+/// a data-dependent branch: `x` is rounded to the nearest integer `f` by adding [`ROUND`],
+/// and where `f > x` (rounded up, which needs `x >= 1/2`) the floor is `f - 1` and the
+/// fraction `x - f + 1`. Both are exact: `x - f` is a multiple of the last place of `x`
+/// below 1/2 in magnitude, and `x - f + 1` lies in `[1/2, 1)` where the spacing of doubles
+/// (`2^-53`) divides the last place of `x >= 1/2`.
 #[inline(always)]
 fn split(w: f64, scale: f64) -> (usize, f64) {
     let x = w * scale;
-    let y = (x - 0.5) + ROUND;
+    let y = x + ROUND;
     let f = y - ROUND;
-    let i = rounded(y);
-    let r = x - f;
-    let over = r >= 1.0;
+    let up = f > x;
     (
-        i.wrapping_add(usize::from(over)),
-        if over { r - 1.0 } else { r },
+        rounded(y).wrapping_sub(usize::from(up)),
+        (x - f) + if up { 1.0 } else { 0.0 },
     )
 }
 
@@ -955,10 +955,18 @@ fn draw_by_rejection<R: Rng + ?Sized>(
         count[t] += u32::from(hit);
         u64::from(hit)
     };
-    while draws - placed >= 2 {
-        let x = rng.next_u64();
-        placed += one(x as u32, rng);
-        placed += one((x >> 32) as u32, rng);
+    // in batches of `(draws - placed) / 2` pairs, which cannot place more than are left:
+    // the same tries as checking before every pair, without the check
+    loop {
+        let pairs = (draws - placed) / 2;
+        if pairs == 0 {
+            break;
+        }
+        for _ in 0..pairs {
+            let x = rng.next_u64();
+            placed += one(x as u32, rng);
+            placed += one((x >> 32) as u32, rng);
+        }
     }
     while placed < draws {
         placed += one(rng.next_u64() as u32, rng);
@@ -1043,19 +1051,21 @@ fn residual_total(weights: &[f64], parts: &mut [Part]) -> Result<f64> {
     use rayon::prelude::*;
     parts.par_iter_mut().for_each(|p| {
         let mut s = [0.0f64; 4];
-        let mut negative = false;
+        // the least weight of each lane (a NaN makes the sum NaN instead)
+        let mut least = [0.0f64; 4];
         let chunks = weights[p.start..p.end].chunks_exact(4);
         let rest = chunks.remainder();
         for q in chunks {
             for l in 0..4 {
                 s[l] += q[l];
-                negative |= q[l] < 0.0;
+                least[l] = if q[l] < least[l] { q[l] } else { least[l] };
             }
         }
         for &v in rest {
             s[0] += v;
-            negative |= v < 0.0;
+            least[0] = if v < least[0] { v } else { least[0] };
         }
+        let negative = least.iter().any(|&v| v < 0.0);
         p.weight_sum = if negative {
             f64::NAN
         } else {

@@ -331,6 +331,32 @@ fn bad_weights_are_typed_errors() {
             "{name}"
         );
     }
+    // from 2^17 weights the residual scheme checks them by parts, in parallel: the first
+    // offending weight is still the one reported, and a negative zero is a valid zero
+    let len = (1 << 17) + 5;
+    let mut out = vec![0usize; len];
+    for (index, value) in [
+        (len - 2, -1e-300),
+        (70_000, f64::NAN),
+        (3, f64::NEG_INFINITY),
+    ] {
+        let mut w = vec![1.0; len];
+        w[index] = value;
+        w[len - 1] = -1.0;
+        for (name, scheme) in schemes() {
+            let got = scheme.resample_into(&w, &mut rng, &mut out);
+            assert!(
+                matches!(got, Err(ParticleError::InvalidWeight { index: i, .. }) if i == index),
+                "{name}, weight {value} at {index}: {got:?}"
+            );
+        }
+    }
+    let mut w = vec![1.0; len];
+    w[100_000] = -0.0;
+    for (name, scheme) in schemes() {
+        scheme.resample_into(&w, &mut rng, &mut out).expect(name);
+        assert!(!out.contains(&100_000), "{name}");
+    }
     let mut out = [0usize; 2];
     assert!(matches!(
         systematic_indices(&[1.0], 1.5, &mut out),
@@ -655,6 +681,49 @@ fn residual_without_remainder_and_other_output_lengths() {
         assert!(
             w.iter().zip(&mean).all(|(&x, &e)| x > 0.0 || e == 0.0),
             "zero weight drawn, n = {n}"
+        );
+    }
+}
+
+/// The residual scheme's copies are exact floors where `n w_i / W` is an integer (odd ones
+/// included, where rounding to the nearest integer and to even differ) or a fraction
+/// (halves included, the ties of rounding to the nearest). The weights sum to `n`, so the
+/// scale is exactly 1: a particle of integer weight gets exactly that many places (its
+/// residual is zero), and over 2000 seeds each particle's places beyond its floor average
+/// its residual `w_i - floor(w_i)` (the three remainder draws are `Multinomial(3, r / 3)`,
+/// so each mean has a standard deviation below 0.02; bound 0.1). A copy too many or too few
+/// for any weight moves its mean by 1.
+#[test]
+fn residual_copies_are_exact_floors() {
+    let w = [
+        3.0, 5.0, 7.0, 1.0, 9.0, 11.0, 13.0, 0.5, 0.5, 2.5, 1.5, 2.0, 3.0, 4.0, 0.75, 0.25,
+    ];
+    let n = 64;
+    assert_eq!(w.iter().sum::<f64>(), n as f64);
+    let seeds = 2000;
+    let mut extra = [0usize; 16];
+    for seed in 0..seeds {
+        let out = Residual
+            .resample(&w, n, &mut ChaCha8Rng::seed_from_u64(seed))
+            .expect("r");
+        let mut count = [0usize; 16];
+        for &i in &out {
+            count[i] += 1;
+        }
+        for (i, &x) in w.iter().enumerate() {
+            let floor = x.floor() as usize;
+            assert!(count[i] >= floor, "seed {seed}, particle {i}: {count:?}");
+            if x == x.floor() {
+                assert_eq!(count[i], floor, "seed {seed}, particle {i}: {count:?}");
+            }
+            extra[i] += count[i] - floor;
+        }
+    }
+    for (i, &x) in w.iter().enumerate() {
+        let mean = extra[i] as f64 / seeds as f64;
+        assert!(
+            (mean - (x - x.floor())).abs() < 0.1,
+            "particle {i}: mean {mean}"
         );
     }
 }
