@@ -2,6 +2,9 @@
 //!
 //! - `kf_step_cv4_pos2`: one KF predict + update (Joseph form), 2-D constant velocity
 //!   (4 states) with a 2-D position observation, trajpred vs adskalman 0.18 (Joseph form);
+//! - `kf_step_general_cv4_pos2`: the same step with models that have neither structure the
+//!   KF exploits (a damped constant velocity, positions measured at twice their scale), so
+//!   both filters take their general products;
 //! - `ukf_step_ct5_rb2`: one UKF predict + update on the 5-state coordinated turn with a
 //!   range-bearing observation (filterpy's figure for the same step comes from
 //!   `benches/filterpy_ukf_step.py`).
@@ -153,6 +156,75 @@ fn kf_step(c: &mut Criterion) {
     g.finish();
 }
 
+/// The CV models of `kf_step` changed so that neither has the structure the KF exploits:
+/// velocities damped by 2 % per step (`F` no longer `I + N`, the dense products and the
+/// `L D L^T` check fused with them) and positions measured at twice their scale (`H` not a
+/// selection, the products with `H`).
+fn general_models() -> (
+    LinearTransition<f64, U4>,
+    LinearObservation<f64, U4, U2>,
+    AdsTransition,
+    AdsObservation,
+) {
+    let cv: LinearTransition<f64, U4> =
+        constant_velocity(2, 0.1, 0.5, StateOrder::AxisBlocks).expect("model");
+    let mut f = *cv.f();
+    f[(1, 1)] = 0.98;
+    f[(3, 3)] = 0.98;
+    let tr = LinearTransition::new(f, *cv.q()).expect("model");
+    let mut h = Matrix2x4::zeros();
+    h[(0, 0)] = 2.0;
+    h[(1, 2)] = 2.0;
+    let ob = LinearObservation::new(h, Matrix2::identity() * 0.3).expect("model");
+    let ads_tr = AdsTransition {
+        f,
+        ft: f.transpose(),
+        q: *tr.q(),
+    };
+    let ads_ob = AdsObservation {
+        h,
+        ht: h.transpose(),
+        r: *ob.r(),
+    };
+    (tr, ob, ads_tr, ads_ob)
+}
+
+fn kf_step_general(c: &mut Criterion) {
+    let (tr, ob, ads_tr, ads_ob) = general_models();
+    let kf = Kf::new(tr, ob).expect("filter");
+    let ads = KalmanFilterNoControl::new(&ads_tr, &ads_ob);
+    let mean = Vector4::new(1.0, 0.5, -2.0, 0.3);
+    let cov = Matrix4::from_diagonal(&Vector4::new(0.5, 0.2, 0.5, 0.2));
+    let state = Gaussian {
+        mean,
+        covariance: cov,
+    };
+    let ads_state = StateAndCovariance::new(mean, cov);
+    let z = Vector2::new(2.14, -3.9);
+    let mut g = c.benchmark_group("kf_step_general_cv4_pos2");
+    g.bench_function("trajpred_joseph", |b| {
+        b.iter(|| {
+            let s = kf
+                .step(black_box(&state), Some(black_box(&z)))
+                .expect("step");
+            black_box(&s);
+        })
+    });
+    g.bench_function("adskalman_joseph", |b| {
+        b.iter(|| {
+            let posterior = ads
+                .step_with_options(
+                    black_box(&ads_state),
+                    black_box(&z),
+                    CovarianceUpdateMethod::JosephForm,
+                )
+                .expect("step");
+            black_box(&posterior);
+        })
+    });
+    g.finish();
+}
+
 fn ukf_step(c: &mut Criterion) {
     let ct = CoordinatedTurn::new(0.5, 0.2, 1e-3).expect("model");
     let rb = RangeBearing::new(Vector2::new(-20.0, 15.0), 0, 2, 0.5, 1e-3).expect("model");
@@ -175,5 +247,5 @@ fn ukf_step(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, kf_step, ukf_step);
+criterion_group!(benches, kf_step, kf_step_general, ukf_step);
 criterion_main!(benches);

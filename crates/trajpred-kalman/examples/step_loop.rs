@@ -7,7 +7,8 @@
 //! ```
 //!
 //! The first argument picks the loop (`kf`, `kf_cheap`, `kf_predict`, `kf_update`, `ads`,
-//! `ads_predict`, `ads_update`, `ukf`, `ukf_corr` (a correlated input state), `ukf_predict`,
+//! `ads_predict`, `ads_update`, `kf_general` and `ads_general` (a damped constant velocity
+//! and positions measured at twice their scale: no structure for the KF to exploit), `ukf`, `ukf_corr` (a correlated input state), `ukf_predict`,
 //! `ukf_update`, `none`), the second the
 //! number of steps. Instructions per step: the difference of two runs with different step
 //! counts divided by the difference of the counts (`none` measures the fixed overhead).
@@ -102,6 +103,29 @@ fn main() {
     let ads_state = StateAndCovariance::new(mean, cov);
     let z = Vector2::new(1.07, -1.95);
 
+    // the general models of the benchmark `kf_step_general_cv4_pos2`
+    let mut f = *kf.transition().f();
+    f[(1, 1)] = 0.98;
+    f[(3, 3)] = 0.98;
+    let mut h = Matrix2x4::zeros();
+    h[(0, 0)] = 2.0;
+    h[(1, 2)] = 2.0;
+    let gen_tr = LinearTransition::new(f, *kf.transition().q()).expect("model");
+    let gen_ob = LinearObservation::new(h, Matrix2::identity() * 0.3).expect("model");
+    let gen_ads_tr = AdsTransition {
+        f,
+        ft: f.transpose(),
+        q: *gen_tr.q(),
+    };
+    let gen_ads_ob = AdsObservation {
+        h,
+        ht: h.transpose(),
+        r: *gen_ob.r(),
+    };
+    let kf_general = Kf::new(gen_tr, gen_ob).expect("filter");
+    let ads_general = KalmanFilterNoControl::new(&gen_ads_tr, &gen_ads_ob);
+    let gz = Vector2::new(2.14, -3.9);
+
     let ct = CoordinatedTurn::new(0.5, 0.2, 1e-3).expect("model");
     let rb = RangeBearing::new(Vector2::new(-20.0, 15.0), 0, 2, 0.5, 1e-3).expect("model");
     let ukf = Ukf::new(ct, rb, MerweSigmaPoints::new(0.5, 2.0, -2.0)).expect("filter");
@@ -150,6 +174,23 @@ fn main() {
                         CovarianceUpdateMethod::JosephForm,
                     )
                     .expect("step"),
+                );
+            }
+            "kf_general" => {
+                let s = kf_general
+                    .step(black_box(&state), Some(black_box(&gz)))
+                    .expect("step");
+                black_box(&s);
+            }
+            "ads_general" => {
+                black_box(
+                    &ads_general
+                        .step_with_options(
+                            black_box(&ads_state),
+                            black_box(&gz),
+                            CovarianceUpdateMethod::JosephForm,
+                        )
+                        .expect("step"),
                 );
             }
             "ads_predict" => {

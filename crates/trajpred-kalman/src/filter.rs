@@ -498,13 +498,14 @@ where
 }
 
 /// `H x`, `H P` and `S = H P H^T + R` (exactly symmetric) for a linear observation model
-/// whose rows select the state components `idx`
+/// whose row `a` selects the state component `at(a)`
 /// ([`LinearObservationModel::selected_components`]): picks of components, rows and a block
-/// of `P` instead of products. The caller has checked `idx.len() == m` and `idx[a] < n`.
+/// of `P` instead of products. `at(a) < n` for `a < m` (the caller checks the selection
+/// once; `at` clamps so that the compiler drops the bounds checks for static sizes).
 #[inline(always)]
 #[allow(clippy::type_complexity)]
 pub(crate) fn selection_products<T, D, M>(
-    idx: &[usize],
+    at: impl Fn(usize) -> usize,
     prior: &Gaussian<T, D>,
     r: &OMatrix<T, M, M>,
 ) -> (OVector<T, M>, OMatrix<T, M, D>, OMatrix<T, M, M>)
@@ -518,10 +519,7 @@ where
     let p = &prior.covariance;
     let (mm, _) = r.shape_generic();
     let (dd, _) = p.shape_generic();
-    let (m, last) = (mm.value(), dd.value() - 1);
-    // `min`: the indices are < n (checked by the caller); it lets the compiler drop the
-    // bounds checks for static sizes
-    let at = |a: usize| idx[a].min(last);
+    let m = mm.value();
     let zp = OVector::<T, M>::from_fn_generic(mm, Const::<1>, |a, _| prior.mean[at(a)]);
     let hp = OMatrix::<T, M, D>::from_fn_generic(mm, dd, |a, c| p[(at(a), c)]);
     let half = nalgebra::convert::<f64, T>(0.5);

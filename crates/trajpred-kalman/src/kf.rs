@@ -41,8 +41,21 @@ pub struct Kf<Tr, Ob> {
     observation: Ob,
     covariance_update: CovarianceUpdate,
     checks: InputChecks,
-    /// The observation selects state components (checked against the sizes once, here).
-    selection: bool,
+    /// How the observation selects state components (checked against the sizes once, in
+    /// [`Kf::new`]).
+    selection: Selection,
+}
+
+/// How the rows of `H` select state components ([`LinearObservationModel::selected_components`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Selection {
+    /// `H` is not a selection: the products with `H`.
+    None,
+    /// Row `a` selects component `stride * a` (`stride` 1 to 3: the positions of the
+    /// kinematic states in either order), indices the compiler knows for static sizes.
+    Strided(usize),
+    /// Any other selection `idx[a] < n`.
+    General,
 }
 
 impl<Tr, Ob> Kf<Tr, Ob> {
@@ -66,9 +79,12 @@ impl<Tr, Ob> Kf<Tr, Ob> {
             observation.observation_matrix().ncols(),
         )?;
         let (n, m) = (transition.state_dim(), observation.observation_dim());
-        let selection = observation
-            .selected_components()
-            .is_some_and(|idx| idx.len() == m && idx.iter().all(|&i| i < n));
+        let selection = match observation.selected_components() {
+            Some(idx) if idx.len() == m && idx.iter().all(|&i| i < n) => (1..=3)
+                .find(|&stride| idx.iter().enumerate().all(|(a, &i)| i == stride * a))
+                .map_or(Selection::General, Selection::Strided),
+            _ => Selection::None,
+        };
         Ok(Kf {
             transition,
             observation,
@@ -192,12 +208,24 @@ where
         z: &OVector<T, M>,
     ) -> Result<Update<T, D, M>> {
         check_dim("prior", self.transition.state_dim(), prior.mean.nrows())?;
-        if self.selection
+        if self.selection != Selection::None
             && let Some(idx) = self.observation.selected_components()
         {
             check_dim("observation", self.observation.observation_dim(), z.nrows())?;
             check_finite(z, "observation")?;
-            let (zp, hp, s) = selection_products(idx, prior, self.observation.observation_noise());
+            let r = self.observation.observation_noise();
+            let last = prior.mean.nrows() - 1;
+            // one arm per stride, so that the indices are constants for static sizes (and
+            // the prior can stay in registers); the general arm reads a copy of the prior
+            let (zp, hp, s) = match self.selection {
+                Selection::Strided(1) => selection_products(|a| a.min(last), prior, r),
+                Selection::Strided(2) => selection_products(|a| (2 * a).min(last), prior, r),
+                Selection::Strided(3) => selection_products(|a| (3 * a).min(last), prior, r),
+                _ => {
+                    let copy = prior.clone();
+                    selection_products(|a| idx[a].min(last), &copy, r)
+                }
+            };
             return finish_update(
                 &self.observation,
                 prior,

@@ -3,8 +3,8 @@
 //! examples worked by hand, forecasts, and a 10^6-step covariance soak.
 
 use nalgebra::{
-    Const, DMatrix, DVector, Matrix1, Matrix1x2, Matrix2, Matrix4, Matrix5, U1, U2, U4, Vector1,
-    Vector2, Vector4, Vector5,
+    Const, DMatrix, DVector, Matrix1, Matrix1x2, Matrix1x4, Matrix2, Matrix2x4, Matrix4, Matrix5,
+    U1, U2, U3, U4, U6, Vector1, Vector2, Vector4, Vector5,
 };
 use rand::RngExt;
 use rand::SeedableRng;
@@ -663,30 +663,45 @@ fn structured_propagation_equals_the_dense_products() {
     assert!(!dense.has_structured_propagation());
 }
 
-#[test]
-fn selection_update_equals_the_general_update() {
-    // the KF picks H x, H P, H P H^T for a position observation; the EKF with the same
-    // linear models takes the general products
-    for order in [StateOrder::AxisBlocks, StateOrder::PositionsFirst] {
-        let tr: LinearTransition<f64, U4> = constant_velocity(2, 0.1, 0.5, order).unwrap();
-        let layout = KinematicLayout::new(2, 2, order).unwrap();
-        let ob: LinearObservation<f64, U4, U2> = position_observation(layout, 0.3).unwrap();
-        use trajpred_kalman::LinearObservationModel;
-        assert!(ob.selected_components().is_some());
-        let kf = Kf::new(&tr, &ob).unwrap();
-        let ekf = Ekf::new(&tr, &ob).unwrap();
-        let a = Matrix4::from_fn(|i, j| ((i * 5 + j * 3) % 7) as f64 * 0.2 - 0.6);
-        let prior = Gaussian {
-            mean: Vector4::new(1.0, 0.5, -2.0, 0.3),
-            covariance: a * a.transpose() + Matrix4::identity() * 0.1,
-        };
-        let z = Vector2::new(1.07, -1.95);
-        let (u, v) = (
-            kf.update(&prior, &z).unwrap(),
-            ekf.update(&prior, &z).unwrap(),
-        );
+/// The KF's update (and step) on the selection picks against the EKF's general products on
+/// the same linear models.
+fn check_selection_update<D: nalgebra::DimName, M: nalgebra::DimName>(
+    tr: &LinearTransition<f64, D>,
+    ob: &LinearObservation<f64, D, M>,
+) where
+    nalgebra::DefaultAllocator: nalgebra::allocator::Allocator<D>
+        + nalgebra::allocator::Allocator<D, D>
+        + nalgebra::allocator::Allocator<M>
+        + nalgebra::allocator::Allocator<M, M>
+        + nalgebra::allocator::Allocator<D, M>
+        + nalgebra::allocator::Allocator<M, D>,
+{
+    use nalgebra::OMatrix;
+    use trajpred_kalman::LinearObservationModel;
+    assert!(ob.selected_components().is_some());
+    let kf = Kf::new(tr, ob).unwrap();
+    let ekf = Ekf::new(tr, ob).unwrap();
+    let a = OMatrix::<f64, D, D>::from_fn(|i, j| ((i * 5 + j * 3) % 7) as f64 * 0.2 - 0.6);
+    let state = Gaussian {
+        mean: OMatrix::<f64, D, nalgebra::U1>::from_fn(|i, _| (i as f64 * 1.3).sin() * 2.0),
+        covariance: &a * a.transpose() + OMatrix::<f64, D, D>::identity() * 0.1,
+    };
+    let z = OMatrix::<f64, M, nalgebra::U1>::from_fn(|i, _| 1.07 - 3.02 * i as f64);
+    let (u, v) = (
+        kf.update(&state, &z).unwrap(),
+        ekf.update(&state, &z).unwrap(),
+    );
+    let (s, t) = (
+        kf.step(&state, Some(&z)).unwrap(),
+        ekf.step(&state, Some(&z)).unwrap(),
+    );
+    for (u, v) in [
+        (&u, &v),
+        (s.update.as_ref().unwrap(), t.update.as_ref().unwrap()),
+    ] {
         assert_close(&u.posterior.mean, &v.posterior.mean, 1e-13, "mean");
         assert_close(&u.posterior.covariance, &v.posterior.covariance, 1e-13, "P");
+        assert_close(&u.innovation, &v.innovation, 1e-14, "y");
         assert_close(
             &u.innovation_covariance,
             &v.innovation_covariance,
@@ -696,6 +711,43 @@ fn selection_update_equals_the_general_update() {
         assert_close(&u.gain, &v.gain, 1e-13, "K");
         assert!((u.log_likelihood() - v.log_likelihood()).abs() < 1e-12);
     }
+    assert_close(&s.prior.covariance, &t.prior.covariance, 1e-13, "prior P");
+}
+
+#[test]
+fn selection_update_equals_the_general_update() {
+    // the KF picks H x, H P, H P H^T for an observation that selects state components (with
+    // the indices as constants for the strides 1 to 3 of the kinematic positions, from a
+    // table otherwise); the EKF with the same linear models takes the general products
+    for order in [StateOrder::AxisBlocks, StateOrder::PositionsFirst] {
+        // strides 2 and 1
+        let tr: LinearTransition<f64, U4> = constant_velocity(2, 0.1, 0.5, order).unwrap();
+        let layout = KinematicLayout::new(2, 2, order).unwrap();
+        let ob: LinearObservation<f64, U4, U2> = position_observation(layout, 0.3).unwrap();
+        check_selection_update(&tr, &ob);
+        // strides 3 and 1
+        let tr: LinearTransition<f64, U6> = constant_acceleration(2, 0.1, 0.5, order).unwrap();
+        let layout = KinematicLayout::new(2, 3, order).unwrap();
+        let ob: LinearObservation<f64, U6, U2> = position_observation(layout, 0.3).unwrap();
+        check_selection_update(&tr, &ob);
+        // three axes, strides 2 and 1
+        let tr: LinearTransition<f64, U6> = constant_velocity(3, 0.1, 0.5, order).unwrap();
+        let layout = KinematicLayout::new(3, 2, order).unwrap();
+        let ob: LinearObservation<f64, U6, U3> = position_observation(layout, 0.3).unwrap();
+        check_selection_update(&tr, &ob);
+    }
+    // other selections: the velocities, the positions swapped, one position (index 2)
+    let tr: LinearTransition<f64, U4> =
+        constant_velocity(2, 0.1, 0.5, StateOrder::AxisBlocks).unwrap();
+    let r = Matrix2::new(0.3, 0.05, 0.05, 0.2);
+    for (i, j) in [(1, 3), (2, 0)] {
+        let mut h = Matrix2x4::zeros();
+        h[(0, i)] = 1.0;
+        h[(1, j)] = 1.0;
+        check_selection_update(&tr, &LinearObservation::new(h, r).unwrap());
+    }
+    let h = Matrix1x4::new(0.0, 0.0, 1.0, 0.0);
+    check_selection_update(&tr, &LinearObservation::new(h, Matrix1::new(0.3)).unwrap());
     // a general H is not a selection
     let ob = LinearObservation::new(Matrix1x2::new(1.0, 0.5), Matrix1::new(0.25)).unwrap();
     use trajpred_kalman::LinearObservationModel;
