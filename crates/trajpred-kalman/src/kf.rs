@@ -8,7 +8,7 @@ use crate::filter::{
     Update, check_prediction, finish_update, linear_predict, linear_predict_unchecked_output,
     linearized_predict, linearized_update, selection_products, validate_state,
 };
-use crate::linalg::{check_dim, check_finite, exactly_symmetric, mul_vec};
+use crate::linalg::{check_dim, check_finite, exactly_symmetric, is_static, mul_vec};
 use crate::model::{
     LinearObservationModel, LinearTransitionModel, ObservationJacobian, TransitionJacobian,
     validate_models,
@@ -214,17 +214,20 @@ where
             check_dim("observation", self.observation.observation_dim(), z.nrows())?;
             check_finite(z, "observation")?;
             let r = self.observation.observation_noise();
-            let last = prior.mean.nrows() - 1;
+            let last = prior.mean.nrows().saturating_sub(1);
             // one arm per stride, so that the indices are constants for static sizes (and
-            // the prior can stay in registers); the general arm reads a copy of the prior
+            // the prior can stay in registers); for static sizes the general arm reads a
+            // copy of the prior (a stack copy, which keeps the run-time indices from
+            // holding the prior itself in memory on every path)
             let (zp, hp, s) = match self.selection {
                 Selection::Strided(1) => selection_products(|a| a.min(last), prior, r),
                 Selection::Strided(2) => selection_products(|a| (2 * a).min(last), prior, r),
                 Selection::Strided(3) => selection_products(|a| (3 * a).min(last), prior, r),
-                _ => {
+                _ if is_static::<D, D>() => {
                     let copy = prior.clone();
                     selection_products(|a| idx[a].min(last), &copy, r)
                 }
+                _ => selection_products(|a| idx[a].min(last), prior, r),
             };
             return finish_update(
                 &self.observation,

@@ -385,9 +385,10 @@ where
     kinematic: Option<Kinematic<T>>,
 }
 
-/// The non-zeros `(i, j, a)` of `N` in `F = I + N`, visited in an order in which, for each
-/// row `i`, `j` ascends, and an entry's `j` is an earlier entry's `i` only if that entry
-/// comes later (so the row updates `F X = X + N X` can run in place).
+/// The non-zeros `(i, j, a)` of `N` in `F = I + N`, visited with `j` ascending for each
+/// row `i` (the order of the sums). The kinematic pattern also never visits an entry whose
+/// `j` is the `i` of an earlier entry, so its row updates `F X = X + N X` run in place; a
+/// general sparse `N` may, and then runs them on a copy (`rows_in_place`).
 trait Shift<T> {
     /// Calls `f(i, j, a)` for every entry, `i, j < n`.
     fn for_each(&self, n: usize, f: impl FnMut(usize, usize, T));
@@ -399,7 +400,7 @@ struct SparseShift<'a, T>(&'a [(usize, usize, T)]);
 impl<T: Copy> Shift<T> for SparseShift<'_, T> {
     #[inline(always)]
     fn for_each(&self, n: usize, mut f: impl FnMut(usize, usize, T)) {
-        let last = n - 1;
+        let last = n.saturating_sub(1);
         for &(i, j, a) in self.0 {
             // indices < n by construction; the `min` drops the bounds checks
             f(i.min(last), j.min(last), a);

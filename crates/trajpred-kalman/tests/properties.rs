@@ -748,6 +748,33 @@ fn selection_update_equals_the_general_update() {
     }
     let h = Matrix1x4::new(0.0, 0.0, 1.0, 0.0);
     check_selection_update(&tr, &LinearObservation::new(h, Matrix1::new(0.3)).unwrap());
+    // run-time sizes: a stride (positions of axis blocks) and a general selection
+    use nalgebra::Dyn;
+    let tr: LinearTransition<f64, Dyn> =
+        constant_velocity(2, 0.1, 0.5, StateOrder::AxisBlocks).unwrap();
+    let layout = KinematicLayout::new(2, 2, StateOrder::AxisBlocks).unwrap();
+    let strided: LinearObservation<f64, Dyn, Dyn> = position_observation(layout, 0.3).unwrap();
+    let general = LinearObservation::new(
+        DMatrix::from_row_slice(2, 4, &[0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]),
+        DMatrix::from_row_slice(2, 2, &[0.3, 0.05, 0.05, 0.2]),
+    )
+    .unwrap();
+    let a = DMatrix::from_fn(4, 4, |i, j| ((i * 5 + j * 3) % 7) as f64 * 0.2 - 0.6);
+    let state = Gaussian {
+        mean: DVector::from_fn(4, |i, _| (i as f64 * 1.3).sin() * 2.0),
+        covariance: &a * a.transpose() + DMatrix::identity(4, 4) * 0.1,
+    };
+    let z = DVector::from_row_slice(&[1.07, -1.95]);
+    for ob in [&strided, &general] {
+        use trajpred_kalman::LinearObservationModel;
+        assert!(ob.selected_components().is_some());
+        let u = Kf::new(&tr, ob).unwrap().step(&state, Some(&z)).unwrap();
+        let v = Ekf::new(&tr, ob).unwrap().step(&state, Some(&z)).unwrap();
+        let (u, v) = (u.update.unwrap(), v.update.unwrap());
+        assert_close(&u.posterior.mean, &v.posterior.mean, 1e-13, "mean");
+        assert_close(&u.posterior.covariance, &v.posterior.covariance, 1e-13, "P");
+        assert_close(&u.gain, &v.gain, 1e-13, "K");
+    }
     // a general H is not a selection
     let ob = LinearObservation::new(Matrix1x2::new(1.0, 0.5), Matrix1::new(0.25)).unwrap();
     use trajpred_kalman::LinearObservationModel;
