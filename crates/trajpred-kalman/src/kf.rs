@@ -166,8 +166,10 @@ where
     /// enters the same element of the posterior with coefficient 1 (`x + K y`, and
     /// `P + U K^T + K U^T` from the lower triangle of `P` or `P - K H P`), so a finite
     /// posterior and an exactly symmetric prior covariance prove the prior finite. The
-    /// prior is checked itself only when the update fails or the prior is not exactly
-    /// symmetric, so the errors are those of `predict` then `update_predicted`.
+    /// triangles are compared only when the transition does not promise them equal
+    /// ([`LinearTransitionModel::mirrors_covariance`]; [`LinearTransition`](crate::LinearTransition)
+    /// does). The prior is checked itself only when the update fails or the prior is not
+    /// exactly symmetric, so the errors are those of `predict` then `update_predicted`.
     #[inline(always)]
     fn predict_update(
         &self,
@@ -189,7 +191,7 @@ where
         )?;
         match self.update_predicted(&prior, z) {
             Ok(update) => {
-                if !exactly_symmetric(&prior.covariance) {
+                if !self.transition.mirrors_covariance() && !exactly_symmetric(&prior.covariance) {
                     check_prediction(&prior)?;
                 }
                 Ok((prior, update))

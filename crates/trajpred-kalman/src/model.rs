@@ -165,6 +165,16 @@ where
     fn has_structured_propagation(&self) -> bool {
         false
     }
+
+    /// `true` promises that [`LinearTransitionModel::propagate_covariance`] returns, for
+    /// every input, a matrix whose two triangles are equal bit for bit (one triangle formed
+    /// and mirrored, as the default method and [`LinearTransition`] do). The KF's observed
+    /// step then proves the prediction finite from the posterior's finiteness (which covers
+    /// the lower triangle) without comparing the triangles. `false` by default, so that a
+    /// model overriding `propagate_covariance` is checked unless it says otherwise.
+    fn mirrors_covariance(&self) -> bool {
+        false
+    }
 }
 
 /// An observation `z = h(x) + v`, `v ~ N(0, R)`, of dimension `M`.
@@ -295,6 +305,10 @@ where
     }
     fn has_structured_propagation(&self) -> bool {
         (**self).has_structured_propagation()
+    }
+    #[inline(always)]
+    fn mirrors_covariance(&self) -> bool {
+        (**self).mirrors_covariance()
     }
 }
 
@@ -734,6 +748,14 @@ where
 
     fn has_structured_propagation(&self) -> bool {
         self.shift.is_some()
+    }
+
+    /// Every path mirrors: the sparse and kinematic updates and the dense products (static
+    /// sizes) form the lower triangle and copy it; run-time sizes' dense products are
+    /// symmetrised, `(a + b) / 2` on both sides, which is the same value.
+    #[inline(always)]
+    fn mirrors_covariance(&self) -> bool {
+        true
     }
 }
 

@@ -284,6 +284,67 @@ fn a_step_reports_the_errors_of_its_prediction_first() {
     );
 }
 
+/// A user's model whose `propagate_covariance` breaks the documented mirror: a NaN in the
+/// upper triangle only, at `(1, 3)`, which the update reads nowhere (the Joseph form reads
+/// the lower triangle, `H P` the rows 0 and 2).
+struct UpperNan(LinearTransition<f64, U4>);
+
+impl trajpred_kalman::Transition<f64, U4> for UpperNan {
+    fn transition(&self, x: &Vector4<f64>) -> trajpred_kalman::Result<Vector4<f64>> {
+        self.0.transition(x)
+    }
+    fn process_noise(&self) -> &Matrix4<f64> {
+        self.0.process_noise()
+    }
+}
+
+impl trajpred_kalman::TransitionJacobian<f64, U4> for UpperNan {
+    fn transition_jacobian(&self, x: &Vector4<f64>) -> trajpred_kalman::Result<Matrix4<f64>> {
+        self.0.transition_jacobian(x)
+    }
+}
+
+impl trajpred_kalman::LinearTransitionModel<f64, U4> for UpperNan {
+    fn transition_matrix(&self) -> &Matrix4<f64> {
+        self.0.transition_matrix()
+    }
+    fn propagate_covariance(&self, p: &Matrix4<f64>) -> Matrix4<f64> {
+        let mut out = self.0.propagate_covariance(p);
+        out[(1, 3)] = f64::NAN;
+        out
+    }
+    fn has_structured_propagation(&self) -> bool {
+        true
+    }
+    // `mirrors_covariance` keeps its default, `false`
+}
+
+#[test]
+fn a_prediction_that_is_not_mirrored_is_checked() {
+    use trajpred_kalman::LinearTransitionModel;
+    let (tr, ob) = cv();
+    assert!(tr.mirrors_covariance());
+    let model = UpperNan(tr);
+    assert!(!model.mirrors_covariance());
+    let kf = Kf::new(&model, &ob).unwrap();
+    let z = Vector2::new(1.0, 2.0);
+    let predicted = |e: &KalmanError| {
+        matches!(
+            e,
+            KalmanError::NonFinite {
+                what: "predicted covariance",
+                index: 13
+            }
+        )
+    };
+    let e = kf.step(&state(), Some(&z)).unwrap_err();
+    assert!(predicted(&e), "step: {e:?}");
+    let e = kf.predict(&state()).unwrap_err();
+    assert!(predicted(&e), "predict: {e:?}");
+    let e = kf.filter(&state(), &[Some(z)]).unwrap_err();
+    assert!(predicted(&e), "filter: {e:?}");
+}
+
 #[test]
 fn s_not_positive_definite_inside_an_update() {
     // A user observation model whose R is validated but whose Jacobian returns NaN-free

@@ -661,6 +661,39 @@ fn structured_propagation_equals_the_dense_products() {
     let dense =
         LinearTransition::new(Matrix2::new(0.9, 0.1, -0.2, 1.0), Matrix2::identity()).unwrap();
     assert!(!dense.has_structured_propagation());
+    // every path of `LinearTransition` mirrors (its `mirrors_covariance` is `true`): the
+    // two triangles equal bit for bit, for the dense products of static and run-time sizes
+    // and for the KF's prediction through the factorisation of `P`
+    let bits_symmetric = |m: &DMatrix<f64>| {
+        (0..m.nrows()).all(|i| (0..i).all(|j| m[(i, j)].to_bits() == m[(j, i)].to_bits()))
+    };
+    let f = Matrix4::from_fn(|i, j| ((i * 3 + j * 5) as f64).sin() * 0.7 + (i == j) as u8 as f64);
+    let a = Matrix4::from_fn(|i, j| ((i * 7 + j * 2 + 1) as f64).cos());
+    let (p, q) = (
+        a * a.transpose() + Matrix4::identity(),
+        a.transpose() * a * 0.1,
+    );
+    let q = (q + q.transpose()) * 0.5;
+    let tr = LinearTransition::new(f, q).unwrap();
+    let dyn_tr = LinearTransition::new(
+        DMatrix::from_column_slice(4, 4, f.as_slice()),
+        DMatrix::from_column_slice(4, 4, q.as_slice()),
+    )
+    .unwrap();
+    assert!(tr.mirrors_covariance() && dyn_tr.mirrors_covariance());
+    assert!(!tr.has_structured_propagation());
+    let to_dyn = |m: &Matrix4<f64>| DMatrix::from_column_slice(4, 4, m.as_slice());
+    assert!(bits_symmetric(&to_dyn(&tr.propagate_covariance(&p))));
+    assert!(bits_symmetric(&dyn_tr.propagate_covariance(&to_dyn(&p))));
+    let ob = LinearObservation::new(Matrix2x4::identity(), Matrix2::identity()).unwrap();
+    let x = Gaussian {
+        mean: Vector4::new(1.0, -2.0, 0.5, 3.0),
+        covariance: p,
+    };
+    for checks in [InputChecks::Full, InputChecks::Cheap] {
+        let kf = Kf::new(&tr, &ob).unwrap().with_input_checks(checks);
+        assert!(bits_symmetric(&to_dyn(&kf.predict(&x).unwrap().covariance)));
+    }
 }
 
 /// The KF's update (and step) on the selection picks against the EKF's general products on
