@@ -171,7 +171,9 @@ where
     /// and mirrored, as the default method and [`LinearTransition`] do). The KF's observed
     /// step then proves the prediction finite from the posterior's finiteness (which covers
     /// the lower triangle) without comparing the triangles. `false` by default, so that a
-    /// model overriding `propagate_covariance` is checked unless it says otherwise.
+    /// model overriding `propagate_covariance` is checked unless it says otherwise; a model
+    /// that returns `true` without mirroring could pass a non-finite upper triangle of the
+    /// prediction to the caller without an error.
     fn mirrors_covariance(&self) -> bool {
         false
     }
