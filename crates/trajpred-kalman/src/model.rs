@@ -20,6 +20,7 @@ use crate::linalg::{
     check_dim, check_finite, check_pd, check_psd, check_square, is_static, mul, mul_tr_sym_plus,
     mul_vec,
 };
+use crate::motion::{KinematicLayout, StateOrder};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
 
@@ -438,22 +439,33 @@ impl<T: Copy, const K: usize, const POSITIONS_FIRST: bool> Shift<T>
 {
     #[inline(always)]
     fn for_each(&self, n: usize, mut f: impl FnMut(usize, usize, T)) {
-        let (axes, last) = (n / K, n - 1);
-        let index = |axis: usize, d: usize| {
-            if POSITIONS_FIRST {
-                d * axes + axis
-            } else {
-                axis * K + d
-            }
-        };
-        for axis in 0..axes {
+        let (layout, last) = (kinematic_layout::<K, POSITIONS_FIRST>(n), n - 1);
+        for axis in 0..layout.axes {
             for d1 in 0..K {
                 for d2 in d1 + 1..K {
-                    let (i, j) = (index(axis, d1).min(last), index(axis, d2).min(last));
+                    let (i, j) = (
+                        layout.index(axis, d1).min(last),
+                        layout.index(axis, d2).min(last),
+                    );
                     f(i, j, self.block[d1][d2]);
                 }
             }
         }
+    }
+}
+
+/// The layout of `n / K` axes of `K` derivatives in the order `POSITIONS_FIRST` (else axis
+/// blocks); any number of axes (the kinematic models' constructors allow 1 to 3).
+#[inline(always)]
+fn kinematic_layout<const K: usize, const POSITIONS_FIRST: bool>(n: usize) -> KinematicLayout {
+    KinematicLayout {
+        axes: n / K,
+        derivatives: K,
+        order: if POSITIONS_FIRST {
+            StateOrder::PositionsFirst
+        } else {
+            StateOrder::AxisBlocks
+        },
     }
 }
 
@@ -494,8 +506,9 @@ where
     if n == 0 || !n.is_multiple_of(K) {
         return None;
     }
-    let axes = n / K;
-    // (axis, derivative) of a state index
+    let layout = kinematic_layout::<K, POSITIONS_FIRST>(n);
+    let axes = layout.axes;
+    // (axis, derivative) of a state index, the inverse of `layout.index`
     let split = |i: usize| {
         if POSITIONS_FIRST {
             (i % axes, i / axes)
@@ -503,17 +516,10 @@ where
             (i / K, i % K)
         }
     };
-    let index = |axis: usize, d: usize| {
-        if POSITIONS_FIRST {
-            d * axes + axis
-        } else {
-            axis * K + d
-        }
-    };
     let mut block = [[T::zero(); K]; K];
     for d1 in 0..K {
         for d2 in d1 + 1..K {
-            block[d1][d2] = f[(index(0, d1), index(0, d2))];
+            block[d1][d2] = f[(layout.index(0, d1), layout.index(0, d2))];
             if block[d1][d2] == T::zero() {
                 return None;
             }

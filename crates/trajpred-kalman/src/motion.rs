@@ -69,6 +69,7 @@ impl KinematicLayout {
     }
 
     /// The index in the state of derivative `derivative` (0 = position) of axis `axis`.
+    #[inline]
     pub fn index(&self, axis: usize, derivative: usize) -> usize {
         match self.order {
             StateOrder::AxisBlocks => axis * self.derivatives + derivative,
