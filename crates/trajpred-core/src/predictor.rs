@@ -169,6 +169,12 @@ pub trait Predictor: Send + Sync {
     fn min_history(&self) -> usize {
         1
     }
+
+    /// What fitting chose, in words (e.g. the HMM's number of states), for reports; `None`
+    /// for a method that learns nothing or has nothing to say.
+    fn fitted_summary(&self) -> Option<String> {
+        None
+    }
 }
 
 impl<P: Predictor + ?Sized> Predictor for Box<P> {
@@ -183,6 +189,9 @@ impl<P: Predictor + ?Sized> Predictor for Box<P> {
     }
     fn min_history(&self) -> usize {
         (**self).min_history()
+    }
+    fn fitted_summary(&self) -> Option<String> {
+        (**self).fitted_summary()
     }
 }
 

@@ -217,6 +217,50 @@ fn fixtures_exercise_the_real_data_path_and_poly1_matches_a_direct_fit() {
     }
 }
 
+/// `trajpred evaluate --protocol` and the reproduction call the same preset and engine: on
+/// the fixtures, the preset's table equals the runner's, row for row and column for column.
+#[test]
+fn the_protocol_preset_gives_the_runners_table() {
+    let root = tempfile::tempdir().expect("tempdir");
+    write_geolife(root.path());
+    write_tdrive(root.path());
+    let c = ctx(Some(root.path().to_path_buf()));
+    let r = papers::kf_dynamic::run(&c).expect("runs on fixtures");
+    for (name, folder, id) in [
+        ("kf-dynamic-geolife", "geolife", "geolife_error_history"),
+        ("kf-dynamic-tdrive", "tdrive", "tdrive_error_history"),
+    ] {
+        let p = trajpred::protocol::preset(name, c.seed, c.quick).expect("preset");
+        // the dataset's root folder, as a user gives it
+        let loaded = trajpred::dataset::load(
+            p.dataset,
+            &root.path().join(folder),
+            &p.load_options,
+            &p.segmentation,
+            p.max_units,
+        )
+        .expect("loads");
+        let run = trajpred::protocol::run(&p, &loaded.segments, &trajpred::protocol::Silent)
+            .expect("runs");
+        let ours = run.history_table();
+        let theirs = table(&r, id);
+        assert_eq!(ours.rows.len(), theirs.rows.len());
+        for (row, (label, values)) in ours.rows.iter().enumerate() {
+            assert_eq!(theirs.rows[row][0], Value::Text(label.clone()));
+            for (col, v) in ours.columns.iter().zip(values) {
+                if col == "accuracy (%)" {
+                    continue; // in the accuracy table, not this one
+                }
+                let want = num(theirs.get(row, col));
+                assert!(
+                    v.to_bits() == want.to_bits(),
+                    "{name} {label} {col}: preset {v}, runner {want}"
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn quick_run_on_the_real_subset() {
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");

@@ -8,10 +8,11 @@
 //! chunks and their partial sums are combined in trajectory order, so results do not depend
 //! on the number of threads and memory holds one chunk of trajectories at a time.
 
+use crate::dataset::Segment;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
-use trajpred_core::{Error, Predictor, Result, Trajectory};
+use trajpred_core::{Error, Point, Predictor, Result, Trajectory};
 
 /// How to evaluate.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -174,19 +175,23 @@ fn evaluate_one(p: &dyn Predictor, tr: &Trajectory, cfg: &EvalConfig) -> Sums {
         };
         match p.forecast(&history, cfg.horizon) {
             Ok(f) if f.horizon() == cfg.horizon && f.dim() == tr.dim() => {
-                s.forecasts += 1;
-                for k in 0..cfg.horizon {
-                    let truth = tr.point(o + 1 + k);
-                    let e2: f64 = f
-                        .step(k + 1)
-                        .iter()
-                        .zip(truth.iter())
-                        .map(|(a, b)| (a - b) * (a - b))
-                        .sum();
-                    let e = e2.sqrt();
-                    s.err[k] += e;
-                    s.err_sq[k] += e2;
-                    s.hits[k] += usize::from(e < cfg.threshold);
+                let predicted: Vec<Point> = f.points().collect();
+                let truth: Vec<Point> = (1..=cfg.horizon).map(|k| tr.point(o + k)).collect();
+                // every error through trajpred-metrics; a non-finite forecast is a failure
+                match trajpred_metrics::euclidean_errors(&predicted, &truth) {
+                    Ok(errors) => {
+                        s.forecasts += 1;
+                        for (k, e) in errors.into_iter().enumerate() {
+                            s.err[k] += e;
+                            s.err_sq[k] += e * e;
+                            s.hits[k] += usize::from(e < cfg.threshold);
+                        }
+                    }
+                    Err(e) => {
+                        s.failures += 1;
+                        s.first_failure
+                            .get_or_insert_with(|| format!("{}: {e}", p.name()));
+                    }
                 }
             }
             Ok(f) => {
@@ -313,43 +318,89 @@ pub enum Split {
         /// Share of each trajectory's points used for training.
         train_fraction: f64,
     },
-    /// A seeded random `train_fraction` of the trajectories trains, the others test.
+    /// A seeded random `train_fraction` of the trajectories (segments) trains, the others
+    /// test. Segments of one trip or one user may land on both sides.
     ByTrajectory {
         /// Share of trajectories used for training.
         train_fraction: f64,
         /// Seed of the shuffle.
         seed: u64,
     },
+    /// A seeded random `train_fraction` of the groups (users, vehicles, files: see
+    /// [`Segment::group`]) trains, the others test: no user is on both sides, which is how
+    /// a method meets new users' data. With at least two groups each side gets one.
+    ByGroup {
+        /// Share of groups used for training.
+        train_fraction: f64,
+        /// Seed of the shuffle.
+        seed: u64,
+    },
 }
 
-/// Splits trajectories into (train, test). Parts too short to form a trajectory are left out.
+impl Split {
+    /// The split's name as the CLI spells it (`by-time`, `by-track`, `by-user`).
+    pub fn label(&self) -> &'static str {
+        match self {
+            Split::ByTime { .. } => "by-time",
+            Split::ByTrajectory { .. } => "by-track",
+            Split::ByGroup { .. } => "by-user",
+        }
+    }
+}
+
+fn check_fraction(f: f64) -> Result<()> {
+    if f > 0.0 && f < 1.0 {
+        Ok(())
+    } else {
+        Err(Error::InvalidParameter {
+            name: "train_fraction",
+            reason: format!("must be in (0, 1), got {f}"),
+        })
+    }
+}
+
+/// Splits trajectories into (train, test). Parts too short to form a trajectory are left
+/// out. With [`Split::ByGroup`] every trajectory is its own group.
 pub fn split(
     trajectories: &[Trajectory],
     how: Split,
 ) -> Result<(Vec<Trajectory>, Vec<Trajectory>)> {
+    let segments: Vec<Segment> = trajectories
+        .iter()
+        .enumerate()
+        .map(|(i, t)| Segment {
+            group: i.to_string(),
+            id: i.to_string(),
+            frame: trajpred_data::Frame::Cartesian,
+            trajectory: t.clone(),
+        })
+        .collect();
+    let (train, test) = split_segments(&segments, how)?;
+    let take = |v: Vec<Segment>| v.into_iter().map(|s| s.trajectory).collect();
+    Ok((take(train), take(test)))
+}
+
+/// Splits segments into (train, test) as `how` says, keeping their order within each side
+/// for [`Split::ByTime`] and the shuffled order otherwise.
+pub fn split_segments(segments: &[Segment], how: Split) -> Result<(Vec<Segment>, Vec<Segment>)> {
     use rand::SeedableRng;
     use rand::seq::SliceRandom;
-    let check = |f: f64| {
-        if f > 0.0 && f < 1.0 {
-            Ok(())
-        } else {
-            Err(Error::InvalidParameter {
-                name: "train_fraction",
-                reason: format!("must be in (0, 1), got {f}"),
-            })
-        }
-    };
     match how {
         Split::ByTime { train_fraction } => {
-            check(train_fraction)?;
+            check_fraction(train_fraction)?;
             let (mut train, mut test) = (Vec::new(), Vec::new());
-            for tr in trajectories {
+            for s in segments {
+                let tr = &s.trajectory;
                 let cut = (tr.len() as f64 * train_fraction).round() as usize;
+                let part = |t: Trajectory| Segment {
+                    trajectory: t,
+                    ..s.clone()
+                };
                 if cut >= 1 {
-                    train.push(tr.slice(0..cut.min(tr.len()))?);
+                    train.push(part(tr.slice(0..cut.min(tr.len()))?));
                 }
                 if cut < tr.len() {
-                    test.push(tr.slice(cut..tr.len())?);
+                    test.push(part(tr.slice(cut..tr.len())?));
                 }
             }
             Ok((train, test))
@@ -358,12 +409,34 @@ pub fn split(
             train_fraction,
             seed,
         } => {
-            check(train_fraction)?;
-            let mut idx: Vec<usize> = (0..trajectories.len()).collect();
+            check_fraction(train_fraction)?;
+            let mut idx: Vec<usize> = (0..segments.len()).collect();
             idx.shuffle(&mut rand_chacha::ChaCha8Rng::seed_from_u64(seed));
-            let cut = (trajectories.len() as f64 * train_fraction).round() as usize;
-            let pick = |ix: &[usize]| ix.iter().map(|&i| trajectories[i].clone()).collect();
+            let cut = (segments.len() as f64 * train_fraction).round() as usize;
+            let pick = |ix: &[usize]| ix.iter().map(|&i| segments[i].clone()).collect();
             Ok((pick(&idx[..cut]), pick(&idx[cut..])))
+        }
+        Split::ByGroup {
+            train_fraction,
+            seed,
+        } => {
+            check_fraction(train_fraction)?;
+            let mut groups: Vec<&str> = segments.iter().map(|s| s.group.as_str()).collect();
+            groups.sort_unstable();
+            groups.dedup();
+            groups.shuffle(&mut rand_chacha::ChaCha8Rng::seed_from_u64(seed));
+            let n = groups.len();
+            let mut cut = (n as f64 * train_fraction).round() as usize;
+            if n >= 2 {
+                cut = cut.clamp(1, n - 1);
+            }
+            let train_groups: std::collections::HashSet<&str> =
+                groups[..cut].iter().copied().collect();
+            let (train, test): (Vec<Segment>, Vec<Segment>) = segments
+                .iter()
+                .cloned()
+                .partition(|s| train_groups.contains(s.group.as_str()));
+            Ok((train, test))
         }
     }
 }

@@ -31,6 +31,7 @@ pub mod dataset;
 pub mod harness;
 pub mod plot;
 pub mod predictors;
+pub mod protocol;
 pub mod registry;
 
 pub use trajpred_core::{Error, Forecast, Predictor, Result, Trajectory};

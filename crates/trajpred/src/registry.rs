@@ -59,6 +59,10 @@ pub const METHODS: &[MethodInfo] = &[
         description: "Kalman filter through the history, then uncorrected CV extrapolation",
     },
     MethodInfo {
+        name: "naive-kf-4d",
+        description: "naive KF with the 4-D position + velocity observation (R = I)",
+    },
+    MethodInfo {
         name: "poly1",
         description: "least-squares line through the last N points, extrapolated",
     },
@@ -163,6 +167,9 @@ pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
             opts.kf_q,
         ))?),
         "naive-kf" => Box::new(NaiveKf::new(KfDynamicParams::paper_position(opts.kf_q))?),
+        "naive-kf-4d" => Box::new(NaiveKf::new(KfDynamicParams::paper_position_velocity(
+            opts.kf_q,
+        ))?),
         "poly1" | "poly2" => Box::new(PolyFit::new(PolyFitParams {
             degree: if name == "poly1" { 1 } else { 2 },
             points: opts.poly_points,
@@ -194,7 +201,7 @@ pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
                 name: "method",
                 reason: format!(
                     "unknown method `{name}`; known: {}",
-                    METHODS
+                    all_methods()
                         .iter()
                         .map(|m| m.name)
                         .collect::<Vec<_>>()

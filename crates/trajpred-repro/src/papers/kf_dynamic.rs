@@ -22,14 +22,13 @@ use crate::{Context, ReproError, Result};
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
 use std::path::{Path, PathBuf};
+use trajpred::dataset::{self, Segment, Segmentation};
 use trajpred::harness::{self, EvalConfig, MethodReport, Split};
 use trajpred::plot::{Chart, Series};
-use trajpred::predictors::{
-    Hmm, HmmParams, KfDynamic, KfDynamicParams, NaiveKf, PolyFit, PolyFitParams,
-};
+use trajpred::predictors::{KfDynamic, KfDynamicParams, NaiveKf};
+use trajpred::protocol::{self, Protocol, ProtocolRun};
 use trajpred::{Predictor, Trajectory};
-use trajpred_data::segment::split_on_gaps;
-use trajpred_data::{LoadOptions, LoadReport, geolife, tdrive};
+use trajpred_data::LoadReport;
 
 /// Why this paper's numbers and ours differ (shown in the results index).
 pub const EXPLANATION: &str = "Why the KF-dynamic numbers differ from the paper's: we run on \
@@ -45,20 +44,10 @@ docs/kf-dynamic.md.";
 const HISTORIES: [usize; 5] = [10, 20, 30, 40, 50];
 /// Forecast steps 1..=HORIZON.
 const HORIZON: usize = 5;
-/// The paper's hit threshold, metres.
-const THRESHOLD_M: f64 = 25.0;
 /// Points fitted by the N-point baselines.
 const POLY_POINTS: usize = 5;
 /// The paper's limit on the sampling interval, seconds.
 const PAPER_MAX_INTERVAL_S: f64 = 5.0;
-/// GeoLife: split trajectories where the interval exceeds this (the paper's limit).
-const GEOLIFE_MAX_INTERVAL_S: f64 = PAPER_MAX_INTERVAL_S;
-/// T-Drive: split where the interval exceeds this (T-Drive's usual reporting interval; the
-/// paper's 5 s leaves nothing long enough, which the run counts and reports).
-const TDRIVE_MAX_INTERVAL_S: f64 = 300.0;
-/// Share of the segments (by trajectory, seeded) that trains the HMM; the rest is the test
-/// pool.
-const TRAIN_FRACTION: f64 = 0.3;
 /// History length of the run-time experiment.
 const TIMING_HISTORY: usize = 20;
 /// Increasing test-set sizes of the run-time experiment (k/TIMING_SIZES of the test pool).
@@ -87,47 +76,17 @@ const MIN_POINTS: usize = MAX_HISTORY + HORIZON;
 /// Points the shortest history needs (for the count at the paper's 5 s limit).
 const MIN_POINTS_SHORTEST: usize = 10 + HORIZON;
 
-/// How much of the data a run uses.
+/// What this runner adds to the protocol presets: the run-time experiment's origins.
 #[derive(Debug, Clone, Copy)]
 struct Budget {
-    /// Read at most this many GeoLife user folders.
-    max_users: Option<usize>,
-    /// Read at most this many T-Drive taxi files.
-    max_taxis: Option<usize>,
-    /// At most this many test trajectories.
-    max_test: usize,
-    /// At most this many training trajectories (HMM).
-    max_train: usize,
-    /// Origins per test trajectory in the history/step grid.
-    origins: usize,
-    /// Points between origins.
-    stride: usize,
     /// Origins per test trajectory in the run-time experiment.
     timing_origins: usize,
 }
 
 impl Budget {
     fn new(quick: bool) -> Self {
-        if quick {
-            Budget {
-                max_users: Some(6),
-                max_taxis: Some(40),
-                max_test: 24,
-                max_train: 24,
-                origins: 4,
-                stride: 10,
-                timing_origins: 2,
-            }
-        } else {
-            Budget {
-                max_users: None,
-                max_taxis: None,
-                max_test: 800,
-                max_train: 400,
-                origins: 8,
-                stride: 10,
-                timing_origins: 4,
-            }
+        Budget {
+            timing_origins: if quick { 2 } else { 4 },
         }
     }
 }
@@ -152,27 +111,13 @@ impl Ds {
             Ds::Tdrive => "T-Drive",
         }
     }
-    fn max_interval(self) -> f64 {
-        match self {
-            Ds::Geolife => GEOLIFE_MAX_INTERVAL_S,
-            Ds::Tdrive => TDRIVE_MAX_INTERVAL_S,
-        }
-    }
-    fn options(self) -> LoadOptions {
-        match self {
-            Ds::Geolife => LoadOptions::geolife(),
-            // no gap split in the loader: the runner splits at its own limits
-            Ds::Tdrive => LoadOptions {
-                max_gap: None,
-                ..LoadOptions::tdrive()
-            },
-        }
-    }
-    fn seed(self, base: u64) -> u64 {
-        match self {
-            Ds::Geolife => base ^ 0x6765_6f6c,
-            Ds::Tdrive => base ^ 0x7464_7276,
-        }
+    /// The protocol preset this dataset runs (segmentation, split, histories, methods).
+    fn protocol(self, ctx: &Context) -> Result<Protocol> {
+        let name = match self {
+            Ds::Geolife => "kf-dynamic-geolife",
+            Ds::Tdrive => "kf-dynamic-tdrive",
+        };
+        protocol::preset(name, ctx.seed, ctx.quick).map_err(experiment_err("protocol"))
     }
 }
 
@@ -258,7 +203,7 @@ fn experiment_err(experiment: &str) -> impl Fn(trajpred::Error) -> ReproError + 
 /// The trajectories of one dataset, as the experiments use them.
 struct Loaded {
     /// Segments with at least [`MIN_POINTS`] points after the gap split.
-    segments: Vec<Trajectory>,
+    segments: Vec<Segment>,
     /// Loader's report over every file read.
     report: LoadReport,
     /// Folder read.
@@ -268,143 +213,64 @@ struct Loaded {
     units_total: usize,
     /// Trajectories the loader returned.
     loaded: usize,
-    /// Segments after the split at the runner's limit (any length).
+    /// Segments after the split at the protocol's limit (any length).
     segments_all: usize,
     /// Segments with at least [`MIN_POINTS_SHORTEST`] points at the paper's 5 s limit.
     paper_limit_usable: usize,
     /// Points in [`Self::segments`].
     points: usize,
+    /// The protocol's gap limit, seconds.
+    max_gap: f64,
 }
 
-fn load(ds: Ds, dir: &Path, budget: &Budget) -> Result<Loaded> {
-    let opts = ds.options();
-    let units: Vec<PathBuf> = match ds {
-        Ds::Geolife => geolife::user_dirs(dir)?,
-        Ds::Tdrive => {
-            let sub = dir.join("taxi_log_2008_by_id");
-            tdrive::files(if sub.is_dir() { &sub } else { dir })?
-        }
+fn load(p: &Protocol, dir: &Path) -> Result<Loaded> {
+    let e = experiment_err("load");
+    let t = dataset::load_tracks(p.dataset, dir, &p.load_options, p.max_units).map_err(&e)?;
+    let paper_limit = Segmentation {
+        max_gap: Some(PAPER_MAX_INTERVAL_S),
+        min_points: MIN_POINTS_SHORTEST,
+        ..Segmentation::default()
     };
-    let units_total = units.len();
-    let cap = match ds {
-        Ds::Geolife => budget.max_users,
-        Ds::Tdrive => budget.max_taxis,
-    };
-    let take = cap.unwrap_or(usize::MAX).min(units_total);
-    let mut report = LoadReport::new();
-    let mut tracks = Vec::new();
-    for unit in &units[..take] {
-        let (t, r) = match ds {
-            Ds::Geolife => geolife::load_user(unit, &opts)?,
-            Ds::Tdrive => tdrive::load_file(unit, &opts)?,
-        };
-        tracks.extend(t);
-        report.merge(r);
-    }
-    let loaded = tracks.len();
-    let (mut segments, mut segments_all, mut paper_limit_usable) = (Vec::new(), 0, 0);
-    for t in tracks {
-        let tr = t.trajectory;
-        if tr.len() >= 2 {
-            paper_limit_usable += split_on_gaps(&tr, PAPER_MAX_INTERVAL_S)?
-                .iter()
-                .filter(|s| s.len() >= MIN_POINTS_SHORTEST)
-                .count();
-        }
-        let parts = if tr.len() >= 2 {
-            split_on_gaps(&tr, ds.max_interval())?
-        } else {
-            vec![tr]
-        };
-        segments_all += parts.len();
-        segments.extend(parts.into_iter().filter(|s| s.len() >= MIN_POINTS));
-    }
-    let points = segments.iter().map(Trajectory::len).sum();
+    let (usable, _) = paper_limit.apply(&t.tracks).map_err(&e)?;
+    let (segments, counts) = p.segmentation.apply(&t.tracks).map_err(&e)?;
     Ok(Loaded {
         segments,
-        report,
+        report: t.report,
         folder: dir.to_path_buf(),
-        units_read: take,
-        units_total,
-        loaded,
-        segments_all,
-        paper_limit_usable,
-        points,
+        units_read: t.units_read,
+        units_total: t.units_total,
+        loaded: t.tracks.len(),
+        segments_all: counts.segments_all,
+        paper_limit_usable: usable.len(),
+        points: counts.points,
+        max_gap: p.segmentation.max_gap.unwrap_or(f64::INFINITY),
     })
 }
 
-/// The grid of one dataset: per method, per history, the harness's report.
+/// The grid of one dataset: per method, per history, the protocol's report.
 struct Grid {
-    /// `reports[m][h]` for METHODS[m] and HISTORIES[h].
-    reports: Vec<Vec<MethodReport>>,
+    /// The protocol's run: `run.reports[m][h]` for METHODS[m] and HISTORIES[h].
+    run: ProtocolRun,
     /// Run-time experiment: per size, (test trajectories, per method report).
     timing: Vec<(usize, Vec<MethodReport>)>,
     /// Extra KF parameter combinations at [`TIMING_HISTORY`]: (label, kf-dynamic, naive).
     combos: Vec<(String, MethodReport, MethodReport)>,
-    /// HMM fit time, seconds, and its chosen number of states.
+    /// HMM fit time, seconds, and what its fit chose.
     hmm_fit_seconds: f64,
-    hmm_states: Option<usize>,
-    train: usize,
-    test: usize,
+    hmm_states: Option<String>,
 }
 
-fn build(method: Method) -> Result<Box<dyn Predictor>> {
-    let e = experiment_err("methods");
-    Ok(match method {
-        Method::KfDyn1 => Box::new(KfDynamic::new(set1()).map_err(&e)?),
-        Method::KfDyn2 => Box::new(KfDynamic::new(set2()).map_err(&e)?),
-        Method::Naive1 => Box::new(NaiveKf::new(set1()).map_err(&e)?),
-        Method::Naive2 => Box::new(NaiveKf::new(set2()).map_err(&e)?),
-        Method::Hmm => {
-            return Err(ReproError::Experiment {
-                experiment: "kf-dynamic/methods".into(),
-                reason: "the HMM is built and fitted separately".into(),
-            });
-        }
-        Method::Poly1 | Method::Poly2 => Box::new(
-            PolyFit::new(PolyFitParams {
-                degree: if method == Method::Poly1 { 1 } else { 2 },
-                points: POLY_POINTS,
-            })
-            .map_err(&e)?,
-        ),
-    })
-}
+/// A progress bar that moves once per stage of the protocol run.
+struct StageBar<'a>(&'a indicatif::ProgressBar);
 
-/// The test trajectories trimmed so that, at history `h`, the first origin is point
-/// `MAX_HISTORY - 1` of the untrimmed trajectory (the same origins for every history).
-fn trimmed(test: &[Trajectory], h: usize) -> Result<Vec<Trajectory>> {
-    test.iter()
-        .map(|t| {
-            t.slice(MAX_HISTORY - h..t.len())
-                .map_err(experiment_err("trim"))
-        })
-        .collect()
-}
-
-fn eval_config(h: usize, budget: &Budget, origins: usize) -> EvalConfig {
-    EvalConfig {
-        history: h,
-        horizon: HORIZON,
-        stride: budget.stride,
-        threshold: THRESHOLD_M,
-        max_origins_per_trajectory: Some(origins),
+impl protocol::Progress for StageBar<'_> {
+    fn finish(&self) {
+        self.0.inc(1);
     }
 }
 
-fn run_grid(ds: Ds, data: &Loaded, ctx: &Context, budget: &Budget) -> Result<Grid> {
-    let seed = ds.seed(ctx.seed);
-    let (mut train, mut test) = harness::split(
-        &data.segments,
-        Split::ByTrajectory {
-            train_fraction: TRAIN_FRACTION,
-            seed,
-        },
-    )
-    .map_err(experiment_err("split"))?;
-    train.truncate(budget.max_train);
-    test.truncate(budget.max_test);
-    if train.is_empty() || test.is_empty() {
+fn run_grid(ds: Ds, p: &Protocol, data: &Loaded, ctx: &Context, budget: &Budget) -> Result<Grid> {
+    if data.segments.len() < 2 {
         return Err(ReproError::Experiment {
             experiment: format!("kf-dynamic/{}", ds.folder()),
             reason: format!(
@@ -414,44 +280,34 @@ fn run_grid(ds: Ds, data: &Loaded, ctx: &Context, budget: &Budget) -> Result<Gri
             ),
         });
     }
-    let mut hmm = Hmm::new(HmmParams {
-        seed,
-        ..HmmParams::default()
-    })
-    .map_err(experiment_err("hmm"))?;
-    let t0 = std::time::Instant::now();
-    hmm.fit(&train).map_err(experiment_err("hmm fit"))?;
-    let hmm_fit_seconds = t0.elapsed().as_secs_f64();
-    let hmm_states = hmm.model().map(|m| m.centroids.len());
-    let mut predictors: Vec<Box<dyn Predictor>> = Vec::with_capacity(METHODS.len());
-    for m in METHODS {
-        if m == Method::Hmm {
-            predictors.push(Box::new(hmm.clone()));
-        } else {
-            predictors.push(build(m)?);
-        }
-    }
-    let n_sizes = TIMING_SIZES.min(test.len());
+    let n_sizes = TIMING_SIZES.min(data.segments.len());
     let bar = ctx.bar(
-        (METHODS.len() * (HISTORIES.len() + n_sizes) + 4) as u64,
+        (METHODS.len() * (2 + n_sizes) + 4) as u64,
         format!("kf-dynamic {}", ds.label()),
     );
-    let mut reports = Vec::with_capacity(METHODS.len());
-    for p in &predictors {
-        let mut row = Vec::with_capacity(HISTORIES.len());
-        for &h in &HISTORIES {
-            let cfg = eval_config(h, budget, budget.origins);
-            row.push(
-                harness::evaluate(p.as_ref(), &trimmed(&test, h)?, &cfg, None)
-                    .map_err(experiment_err("grid"))?,
-            );
-            bar.inc(1);
-        }
-        reports.push(row);
+    let run = protocol::run(p, &data.segments, &StageBar(&bar)).map_err(experiment_err("grid"))?;
+    if run.train.is_empty() {
+        return Err(ReproError::Experiment {
+            experiment: format!("kf-dynamic/{}", ds.folder()),
+            reason: "no training segment".into(),
+        });
     }
+    let hmm_i = METHODS.iter().position(|&m| m == Method::Hmm).unwrap_or(0);
+    let hmm_fit_seconds = run.fit_seconds[hmm_i];
+    let hmm_states = run.predictors[hmm_i].fitted_summary();
     // run time against the number of test trajectories: seeded random samples of the pool
-    let timing_test = trimmed(&test, TIMING_HISTORY)?;
-    let cfg = eval_config(TIMING_HISTORY, budget, budget.timing_origins);
+    let seed = match p.split {
+        Split::ByTrajectory { seed, .. } | Split::ByGroup { seed, .. } => seed,
+        Split::ByTime { .. } => ctx.seed,
+    };
+    let timing_test = p
+        .test_at(&run.test, TIMING_HISTORY)
+        .map_err(experiment_err("trim"))?;
+    let n_sizes = TIMING_SIZES.min(timing_test.len());
+    let cfg = EvalConfig {
+        max_origins_per_trajectory: Some(budget.timing_origins),
+        ..p.config(TIMING_HISTORY)
+    };
     let mut timing = Vec::with_capacity(n_sizes);
     for k in 1..=n_sizes {
         let n = (k * timing_test.len()).div_ceil(n_sizes);
@@ -461,9 +317,9 @@ fn run_grid(ds: Ds, data: &Loaded, ctx: &Context, budget: &Budget) -> Result<Gri
         ));
         let sample: Vec<Trajectory> = idx[..n].iter().map(|&i| timing_test[i].clone()).collect();
         let mut per = Vec::with_capacity(METHODS.len());
-        for p in &predictors {
+        for pr in &run.predictors {
             per.push(
-                harness::evaluate(p.as_ref(), &sample, &cfg, None)
+                harness::evaluate(pr.as_ref(), &sample, &cfg, None)
                     .map_err(experiment_err("timing"))?,
             );
             bar.inc(1);
@@ -471,7 +327,7 @@ fn run_grid(ds: Ds, data: &Loaded, ctx: &Context, budget: &Budget) -> Result<Gri
         timing.push((n, per));
     }
     // the other two pairings of Table 1's R and Q
-    let cfg = eval_config(TIMING_HISTORY, budget, budget.origins);
+    let cfg = p.config(TIMING_HISTORY);
     let mut combos = Vec::new();
     for params in [
         KfDynamicParams::paper_position(100.0),
@@ -488,13 +344,11 @@ fn run_grid(ds: Ds, data: &Loaded, ctx: &Context, budget: &Budget) -> Result<Gri
     }
     bar.finish_and_clear();
     Ok(Grid {
-        reports,
+        run,
         timing,
         combos,
         hmm_fit_seconds,
         hmm_states,
-        train: train.len(),
-        test: test.len(),
     })
 }
 
@@ -508,32 +362,29 @@ fn mean(v: impl IntoIterator<Item = f64>) -> f64 {
 }
 
 impl Grid {
+    fn index(m: Method) -> usize {
+        METHODS.iter().position(|&x| x == m).unwrap_or(0)
+    }
     fn report(&self, m: Method) -> &[MethodReport] {
-        let i = METHODS.iter().position(|&x| x == m).unwrap_or(0);
-        &self.reports[i]
+        &self.run.reports[Self::index(m)]
     }
     /// Mean Euclidean error over every step and history.
     fn error(&self, m: Method) -> f64 {
-        mean(self.report(m).iter().map(|r| r.mean_euclidean_all))
+        self.run.error(Self::index(m))
     }
     /// Accuracy (percent) over every step and history.
     fn accuracy(&self, m: Method) -> f64 {
-        100.0 * mean(self.report(m).iter().map(|r| r.hit_rate_all))
+        self.run.accuracy(Self::index(m))
     }
     /// Root mean square error over every step and history.
     fn rmse(&self, m: Method) -> f64 {
-        mean(
-            self.report(m)
-                .iter()
-                .flat_map(|r| r.rms_euclidean.iter().map(|x| x * x)),
-        )
-        .sqrt()
+        self.run.rmse(Self::index(m))
     }
     fn step_error(&self, m: Method, k: usize) -> f64 {
-        mean(self.report(m).iter().map(|r| r.mean_euclidean[k]))
+        self.run.step_error(Self::index(m), k)
     }
     fn step_accuracy(&self, m: Method, k: usize) -> f64 {
-        100.0 * mean(self.report(m).iter().map(|r| r.hit_rate[k]))
+        self.run.step_accuracy(Self::index(m), k)
     }
     fn fitting_error(&self) -> f64 {
         mean([self.error(Method::Poly1), self.error(Method::Poly2)])
@@ -559,13 +410,23 @@ fn paper_for(ds: Ds, m: Method, value: f64) -> Value {
     }
 }
 
-fn tables_and_figures(ds: Ds, g: &Grid, budget: &Budget, out: &mut PaperResult) -> Result<()> {
+fn tables_and_figures(
+    ds: Ds,
+    p: &Protocol,
+    g: &Grid,
+    budget: &Budget,
+    out: &mut PaperResult,
+) -> Result<()> {
     let slug = ds.folder();
     let name = ds.label();
     let setup = format!(
         "{name}: {} test trajectories, at most {} origins each, {} points apart, the same \
-         origins for every history; HMM fitted on {} other trajectories.",
-        g.test, budget.origins, budget.stride, g.train
+         origins for every history; HMM fitted on {} other trajectories (protocol `{}`).",
+        g.run.test.len(),
+        p.max_origins.unwrap_or(0),
+        p.stride,
+        g.run.train.len(),
+        p.name
     );
     let hcol = |h: usize| format!("h = {h}");
     // error and accuracy against history
@@ -589,7 +450,7 @@ fn tables_and_figures(ds: Ds, g: &Grid, budget: &Budget, out: &mut PaperResult) 
         t = t.paper("paper", 1);
         for (mi, &m) in METHODS.iter().enumerate() {
             let mut row: Vec<Value> = vec![m.label().into()];
-            for r in &g.reports[mi] {
+            for r in &g.run.reports[mi] {
                 row.push(if is_err {
                     r.mean_euclidean_all.into()
                 } else {
@@ -629,7 +490,7 @@ fn tables_and_figures(ds: Ds, g: &Grid, budget: &Budget, out: &mut PaperResult) 
                         m.short(),
                         HISTORIES
                             .iter()
-                            .zip(&g.reports[mi])
+                            .zip(&g.run.reports[mi])
                             .map(|(&h, r)| {
                                 let y = if is_err {
                                     r.mean_euclidean_all
@@ -753,7 +614,8 @@ fn tables_and_figures(ds: Ds, g: &Grid, budget: &Budget, out: &mut PaperResult) 
          trajectories (the paper: 1000..10000 from the full dataset; our subset holds fewer), \
          at most {} origins per trajectory. Wall times are of this machine, shared with other \
          jobs, evaluated in parallel; the HMM's fit on the training part is timed once.",
-        g.test, budget.timing_origins
+        g.run.test.len(),
+        budget.timing_origins
     ));
     t.note("The paper shows run times only as a figure (no numbers).");
     out.tables.push(t);
@@ -869,7 +731,7 @@ fn data_lines(ds: Ds, d: &Loaded) -> Vec<String> {
              {MIN_POINTS} points ({} points) used; at the paper's {} s limit, {} segments \
              would have at least {MIN_POINTS_SHORTEST} points.",
             ds.label(),
-            ds.max_interval(),
+            d.max_gap,
             d.segments_all,
             d.segments.len(),
             d.points,
@@ -1047,26 +909,27 @@ pub fn run(ctx: &Context) -> Result<PaperResult> {
             continue;
         };
         let t0 = std::time::Instant::now();
-        let data = load(ds, &dir, &budget)?;
+        let p = ds.protocol(ctx)?;
+        let data = load(&p, &dir)?;
         let load_s = t0.elapsed().as_secs_f64();
         out.data.extend(data_lines(ds, &data));
         out.data.push(format!(
             "{}: reading and splitting took {load_s:.1} s of wall time.",
             ds.label()
         ));
-        let grid = run_grid(ds, &data, ctx, &budget)?;
-        tables_and_figures(ds, &grid, &budget, &mut out)?;
+        let grid = run_grid(ds, &p, &data, ctx, &budget)?;
+        tables_and_figures(ds, &p, &grid, &budget, &mut out)?;
         claims(ds, &grid, &mut out);
-        if let Some(k) = grid.hmm_states {
+        if let Some(k) = &grid.hmm_states {
             out.notes.push(format!(
-                "{}: the HMM chose {k} motion states on its training part.",
+                "{}: the HMM chose {k} on its training part.",
                 ds.label()
             ));
         }
         grids.push((ds, grid));
     }
     out.tables.insert(0, headline(&grids)?);
-    notes(ctx, &budget, &mut out);
+    notes(ctx, &mut out)?;
     Ok(out)
 }
 
@@ -1113,32 +976,45 @@ fn headline(grids: &[(Ds, Grid)]) -> Result<Table> {
     Ok(t)
 }
 
-fn notes(ctx: &Context, budget: &Budget, out: &mut PaperResult) {
+fn notes(ctx: &Context, out: &mut PaperResult) -> Result<()> {
+    let geo = Ds::Geolife.protocol(ctx)?;
+    let td = Ds::Tdrive.protocol(ctx)?;
+    let fraction = match geo.split {
+        Split::ByTime { train_fraction }
+        | Split::ByTrajectory { train_fraction, .. }
+        | Split::ByGroup { train_fraction, .. } => train_fraction,
+    };
     out.notes.push(format!(
         "Data: subsets of GeoLife and T-Drive (see data above), not the full datasets, so the \
          test sets are smaller than the paper's; {}at most {} test and {} training \
-         trajectories per dataset (seeded split by trajectory, training share {TRAIN_FRACTION}), \
-         at most {} origins per test trajectory {} points apart.",
+         trajectories per dataset (seeded split {}, training share {fraction}), at most {} \
+         origins per test trajectory {} points apart. The protocols are the presets \
+         `{}` and `{}` (`trajpred protocols`), which `trajpred evaluate --protocol` runs alike.",
         if ctx.quick {
             format!(
                 "quick run: at most {} GeoLife user folders and {} T-Drive taxi files read, ",
-                budget.max_users.unwrap_or(0),
-                budget.max_taxis.unwrap_or(0)
+                geo.max_units.unwrap_or(0),
+                td.max_units.unwrap_or(0)
             )
         } else {
             String::new()
         },
-        budget.max_test,
-        budget.max_train,
-        budget.origins,
-        budget.stride
+        geo.max_test.unwrap_or(0),
+        geo.max_train.unwrap_or(0),
+        geo.split.label(),
+        geo.max_origins.unwrap_or(0),
+        geo.stride,
+        geo.name,
+        td.name,
     ));
+    let gap = |p: &Protocol| p.segmentation.max_gap.unwrap_or(f64::INFINITY);
+    let (geolife_gap, tdrive_gap) = (gap(&geo), gap(&td));
     out.notes.push(format!(
         "Sampling: GeoLife trajectories are split where successive points are more than \
-         {GEOLIFE_MAX_INTERVAL_S} s apart (the paper's limit, stated for T-Drive). T-Drive taxis \
+         {geolife_gap} s apart (the paper's limit, stated for T-Drive). T-Drive taxis \
          mostly report every few minutes, so the {PAPER_MAX_INTERVAL_S} s limit leaves almost \
          nothing (counted in the data lines above); we split T-Drive at \
-         {TDRIVE_MAX_INTERVAL_S} s instead, so its steps are minutes long and its errors far \
+         {tdrive_gap} s instead, so its steps are minutes long and its errors far \
          larger than GeoLife's. Segments need {MIN_POINTS} points (history {MAX_HISTORY} + \
          {HORIZON} steps)."
     ));
@@ -1173,4 +1049,5 @@ fn notes(ctx: &Context, budget: &Budget, out: &mut PaperResult) {
          per-forecast errors.",
         HISTORIES
     ));
+    Ok(())
 }

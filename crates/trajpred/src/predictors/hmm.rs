@@ -344,6 +344,12 @@ impl Predictor for Hmm {
         "hmm"
     }
 
+    fn fitted_summary(&self) -> Option<String> {
+        self.model
+            .as_ref()
+            .map(|m| format!("{} motion states", m.centroids.len()))
+    }
+
     fn fit(&mut self, train_set: &[Trajectory]) -> Result<()> {
         let seqs: Vec<Vec<Vec<f64>>> = train_set
             .iter()
