@@ -157,7 +157,8 @@ pub fn parse<R: Read>(
         return Err(Error::parse(file, 1, "no header"));
     };
     let mut out = Vec::new();
-    c.finish(&stem(Path::new(file)), points, cl.kind, &mut out)?;
+    let id = stem(Path::new(file));
+    c.finish(&id, &id, points, cl.kind, &mut out)?;
     Ok(out)
 }
 
