@@ -426,7 +426,8 @@ pub fn parse_json(
         if let Some(f) = &key.2 {
             id = format!("{id}/{f}");
         }
-        c.finish(&id, pts, FrameKind::Geodetic, &mut out)?;
+        let aircraft = key.0.as_deref().unwrap_or("?");
+        c.finish(&id, aircraft, pts, FrameKind::Geodetic, &mut out)?;
     }
     Ok(out)
 }

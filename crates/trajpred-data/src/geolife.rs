@@ -8,6 +8,11 @@
 //!
 //! Streaming: [`user_dirs`] lists the users; [`load_user`] loads one user's folder,
 //! [`load_plt`] one file, so memory stays bounded; [`load_data_dir`] loads everything.
+//! [`user_dirs`] and [`load_data_dir`] take the dataset's root (`geolife/`) or its `Data/`
+//! folder alike.
+//!
+//! A track's id is `<user>/<file stem>` (`#k` appended for the k-th segment after a gap) and
+//! its [`Track::group`] is the user, so data can be split by user.
 //!
 //! ```
 //! use trajpred_data::{geolife, LoadOptions, SkipReason};
@@ -34,7 +39,8 @@ pub const HEADER_LINES: usize = 6;
 pub const UNKNOWN_ALTITUDE_FT: f64 = -777.0;
 
 /// Parses one `.plt` stream named `file` into the tracks of trajectory `id`, adding to
-/// `report`.
+/// `report`. The tracks' [`Track::group`] is `id` up to its first `/` (the user, for the
+/// `user/stem` ids of [`load_plt`]), or all of `id`.
 pub fn parse_plt<R: BufRead>(
     reader: R,
     file: &str,
@@ -72,7 +78,8 @@ pub fn parse_plt<R: BufRead>(
         }
     })?;
     let mut out = Vec::new();
-    c.finish(id, points, FrameKind::Geodetic, &mut out)?;
+    let group = id.split_once('/').map_or(id, |(user, _)| user);
+    c.finish(id, group, points, FrameKind::Geodetic, &mut out)?;
     Ok(out)
 }
 
@@ -128,7 +135,7 @@ pub fn load_user(user_dir: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, Loa
 }
 
 /// The user folders (those holding a `Trajectory/` folder) of a GeoLife `Data/` folder, or
-/// of its parent, sorted.
+/// of the dataset's root holding it (`geolife/Data/<user>/Trajectory/*.plt`), sorted.
 pub fn user_dirs(data_dir: &Path) -> Result<Vec<PathBuf>> {
     let dir = if data_dir.join("Data").is_dir() {
         data_dir.join("Data")
@@ -138,7 +145,8 @@ pub fn user_dirs(data_dir: &Path) -> Result<Vec<PathBuf>> {
     list(&dir, |p| p.join("Trajectory").is_dir())
 }
 
-/// Loads every user of a GeoLife `Data/` folder (see [`user_dirs`]).
+/// Loads every user of a GeoLife `Data/` folder or of the dataset's root (see
+/// [`user_dirs`]).
 pub fn load_data_dir(data_dir: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadReport)> {
     let mut tracks = Vec::new();
     let mut report = LoadReport::new();

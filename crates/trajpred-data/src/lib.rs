@@ -2,11 +2,13 @@
 //!
 //! Trajectory data for trajpred, in metres:
 //!
-//! - loaders, each returning [`Track`]s (a [`trajpred_core::Trajectory`] with its id, source
-//!   and [`Frame`]) and a [`LoadReport`] (files, records, points kept, and every skip by
-//!   [`SkipReason`] with file and line):
+//! - loaders, each returning [`Track`]s (a [`trajpred_core::Trajectory`] with its id, group
+//!   (the user or vehicle, to split data by), source and [`Frame`]) and a [`LoadReport`]
+//!   (files, records, points kept, every skip by [`SkipReason`] with file and line, the CSV
+//!   time units):
 //!   [`geolife`] (`.plt` and `labels.txt`), [`tdrive`] (taxi logs), [`adsb`] (the `traffic`
-//!   package's JSON, both layouts, gzip) and [`csvfile`] (`t,x,y[,z]` or `t,lat,lon[,alt]`);
+//!   package's JSON, both layouts, gzip) and [`csvfile`] (`t,x,y[,z]` or `t,lat,lon[,alt]`,
+//!   optional track column, seconds, epoch milliseconds or ISO 8601 times);
 //!   configured by [`LoadOptions`] (projection, altitude, bounding box, gap split, minimum
 //!   length, strictness); each loads one file or folder at a time, so memory stays bounded;
 //! - [`segment`]: split on gaps, keep long trajectories, resample to a fixed step;
@@ -49,4 +51,5 @@ pub mod track;
 
 pub use error::{Error, Result};
 pub use report::{LoadReport, Skip, SkipReason};
+pub use time::TimeUnit;
 pub use track::{BoundingBox, Frame, LoadOptions, Projection, Track};

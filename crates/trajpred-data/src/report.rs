@@ -1,5 +1,6 @@
 //! What a loader read and what it skipped, by reason and line.
 
+use crate::time::TimeUnit;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt;
@@ -26,6 +27,10 @@ pub enum SkipReason {
     RepeatedTimestamp,
     /// A timestamp earlier than the previous kept point's (dropped).
     TimeBackwards,
+    /// A point whose timestamp jumps ahead of the points that follow it (a clock glitch:
+    /// the track goes on from before it); the one point is dropped, not the rest (see
+    /// `docs/data.md`, the time rule).
+    TimeOutlier,
     /// A T-Drive line whose taxi id differs from the first line's id in that file.
     ForeignId,
     /// A point of a segment with fewer than the required number of points (after splitting
@@ -35,7 +40,7 @@ pub enum SkipReason {
 
 impl SkipReason {
     /// Every reason, in report order.
-    pub const ALL: [SkipReason; 10] = [
+    pub const ALL: [SkipReason; 11] = [
         SkipReason::Malformed,
         SkipReason::InvalidCoordinate,
         SkipReason::MissingValue,
@@ -44,6 +49,7 @@ impl SkipReason {
         SkipReason::OutsideBounds,
         SkipReason::RepeatedTimestamp,
         SkipReason::TimeBackwards,
+        SkipReason::TimeOutlier,
         SkipReason::ForeignId,
         SkipReason::ShortSegment,
     ];
@@ -60,6 +66,7 @@ impl fmt::Display for SkipReason {
             SkipReason::OutsideBounds => "outside bounding box",
             SkipReason::RepeatedTimestamp => "repeated timestamp",
             SkipReason::TimeBackwards => "time goes backwards",
+            SkipReason::TimeOutlier => "time outlier",
             SkipReason::ForeignId => "foreign id",
             SkipReason::ShortSegment => "segment too short",
         };
@@ -103,12 +110,13 @@ pub struct LoadReport {
     pub points_kept: usize,
     /// Trajectories returned.
     pub trajectories: usize,
-    /// Groups before cleaning and splitting at gaps: one per file for GeoLife, T-Drive and
-    /// CSV; for ADS-B, the distinct (icao24, callsign[, flight_id]) keys of each file's
-    /// records.
+    /// Groups before cleaning and splitting at gaps: one per file for GeoLife and T-Drive;
+    /// for CSV, one per file, or one per distinct value of its track/id column; for ADS-B,
+    /// the distinct (icao24, callsign[, flight_id]) keys of each file's records.
     pub groups: usize,
     skipped: BTreeMap<SkipReason, usize>,
     details: Vec<Skip>,
+    time_units: Vec<(String, TimeUnit)>,
 }
 
 impl LoadReport {
@@ -164,8 +172,21 @@ impl LoadReport {
         &self.details
     }
 
+    /// Records the time unit detected in `file` (CSV).
+    pub fn record_time_unit(&mut self, file: &str, unit: TimeUnit) {
+        self.time_units.push((file.to_string(), unit));
+    }
+
+    /// The time unit detected in each CSV file read, in reading order. A file without a
+    /// single readable time value has no entry; the other formats have fixed units and no
+    /// entries.
+    pub fn time_units(&self) -> &[(String, TimeUnit)] {
+        &self.time_units
+    }
+
     /// Adds `other`'s counts and details to this report.
     pub fn merge(&mut self, other: LoadReport) {
+        self.time_units.extend(other.time_units);
         self.files_read += other.files_read;
         self.records_read += other.records_read;
         self.header_lines += other.header_lines;

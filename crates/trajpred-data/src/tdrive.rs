@@ -9,6 +9,10 @@
 //! longer than [`LoadOptions::max_gap`]. The times (most likely Beijing local time) are read
 //! as if UTC.
 //!
+//! [`load_dir`] and [`files`] take the dataset's root (`tdrive/`, holding
+//! `taxi_log_2008_by_id/`) or the folder of the taxi files itself. A track's id is the taxi
+//! id (`#k` appended for the k-th segment after a gap), and [`Track::group`] is the taxi id.
+//!
 //! ```
 //! use trajpred_data::{tdrive, LoadOptions, SkipReason};
 //! let f = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/tdrive/7.txt");
@@ -103,7 +107,7 @@ pub fn parse<R: BufRead>(
     })?;
     let id = taxi.unwrap_or_else(|| stem(Path::new(file)));
     let mut out = Vec::new();
-    c.finish(&id, points, FrameKind::Geodetic, &mut out)?;
+    c.finish(&id, &id, points, FrameKind::Geodetic, &mut out)?;
     Ok(out)
 }
 
@@ -114,9 +118,15 @@ pub fn load_file(path: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadRep
     Ok((tracks, report))
 }
 
+/// The folder of the taxi files inside the dataset's root folder.
+pub const INNER_DIR: &str = "taxi_log_2008_by_id";
+
 /// The `.txt` files of a T-Drive folder, sorted by taxi id (numerically where the stem is a
-/// number).
+/// number). `dir` is either the folder of the taxi files or the dataset's root holding it as
+/// [`INNER_DIR`] (`tdrive/taxi_log_2008_by_id/*.txt`), which is then listed instead.
 pub fn files(dir: &Path) -> Result<Vec<PathBuf>> {
+    let inner = dir.join(INNER_DIR);
+    let dir = if inner.is_dir() { &inner } else { dir };
     let mut v = list(dir, |p| {
         p.is_file() && p.extension().is_some_and(|e| e.eq_ignore_ascii_case("txt"))
     })?;
@@ -124,7 +134,7 @@ pub fn files(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(v)
 }
 
-/// Loads every taxi file of a folder (see [`files`]).
+/// Loads every taxi file of a folder, or of the dataset's root folder (see [`files`]).
 pub fn load_dir(dir: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadReport)> {
     let mut tracks = Vec::new();
     let mut report = LoadReport::new();

@@ -109,6 +109,90 @@ pub fn parse_datetime(s: &str) -> Option<f64> {
     parse_date_time(d, t)
 }
 
+/// An ISO 8601 date-time to seconds since the Unix epoch: `YYYY-MM-DDTHH:MM:SS` (or a space
+/// instead of `T`), optional fractional seconds (`.5`), then optionally `Z` (UTC) or a UTC
+/// offset `±HH:MM` / `±HHMM` / `±HH` (subtracted, so the result is UTC). Without a suffix the
+/// time is read as UTC.
+///
+/// ```
+/// use trajpred_data::time::parse_iso8601;
+/// assert_eq!(parse_iso8601("2008-10-23T02:53:04Z"), Some(1_224_730_384.0));
+/// assert_eq!(parse_iso8601("2008-10-23 02:53:04.5"), Some(1_224_730_384.5));
+/// assert_eq!(parse_iso8601("2008-10-23T10:53:04+08:00"), Some(1_224_730_384.0));
+/// assert_eq!(parse_iso8601("2008-10-23"), None); // a date alone is not a time
+/// ```
+pub fn parse_iso8601(s: &str) -> Option<f64> {
+    let s = s.trim_ascii();
+    let b = s.as_bytes();
+    // the date part is exactly `YYYY-MM-DD`, then `T`, `t` or one space
+    if b.len() < 19 || b[4] != b'-' || b[7] != b'-' || !matches!(b[10], b'T' | b't' | b' ') {
+        return None;
+    }
+    let days = parse_date(s.get(..10)?)?;
+    let rest = s.get(11..)?;
+    let (time, offset) = split_offset(rest)?;
+    // `HH:MM:SS` with optional fraction: at least 8 characters, two-digit fields
+    let tb = time.as_bytes();
+    if tb.len() < 8 || (tb.len() > 8 && tb[8] != b'.') {
+        return None;
+    }
+    Some(days as f64 * 86_400.0 + parse_time(time)? - offset)
+}
+
+/// Splits a time of day from its zone suffix: `Z`/`z` (0) or `±HH[:MM]`/`±HHMM` (seconds).
+fn split_offset(s: &str) -> Option<(&str, f64)> {
+    if let Some(t) = s.strip_suffix(['Z', 'z']) {
+        return Some((t, 0.0));
+    }
+    let Some(i) = s.rfind(['+', '-']) else {
+        return Some((s, 0.0));
+    };
+    let (time, zone) = (s.get(..i)?, s.get(i..)?);
+    let sign = if zone.starts_with('-') { -1.0 } else { 1.0 };
+    let digits: String = zone[1..].chars().filter(|c| *c != ':').collect();
+    let colons = zone[1..].matches(':').count();
+    let ok_shape = match (zone.len() - 1, colons) {
+        (2, 0) | (4, 0) => true,
+        (5, 1) => zone.as_bytes().get(3) == Some(&b':'),
+        _ => false,
+    };
+    if !ok_shape || !digits.bytes().all(|c| c.is_ascii_digit()) {
+        return None;
+    }
+    let h: u32 = digits.get(..2)?.parse().ok()?;
+    let m: u32 = match digits.get(2..) {
+        Some("") | None => 0,
+        Some(m) => m.parse().ok()?,
+    };
+    if h > 23 || m > 59 {
+        return None;
+    }
+    Some((time, sign * f64::from(h * 3600 + m * 60)))
+}
+
+/// The unit of a CSV file's time column, detected per file (see [`crate::csvfile`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+pub enum TimeUnit {
+    /// Plain numbers (magnitude below 1e11), taken as seconds.
+    Seconds,
+    /// Numbers of magnitude at least 1e11: milliseconds since the Unix epoch (1e11 ms is
+    /// 1973-03-03), divided by 1000.
+    EpochMillis,
+    /// ISO 8601 date-times (`2008-10-23T02:53:04Z`, see [`parse_iso8601`]), to seconds since
+    /// the Unix epoch.
+    Iso8601,
+}
+
+impl std::fmt::Display for TimeUnit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            TimeUnit::Seconds => "seconds",
+            TimeUnit::EpochMillis => "epoch milliseconds",
+            TimeUnit::Iso8601 => "ISO 8601",
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -126,6 +210,41 @@ mod tests {
         assert_eq!(parse_date("2000-02-29"), Some(11_016));
         assert_eq!(parse_date("2008/05/30"), parse_date("2008-05-30"));
         assert_eq!(parse_time("00:00:01.5"), Some(1.5));
+    }
+
+    #[test]
+    fn iso8601_forms() {
+        let t = 1_224_730_384.0;
+        for s in [
+            "2008-10-23T02:53:04Z",
+            "2008-10-23T02:53:04",
+            "2008-10-23 02:53:04",
+            "2008-10-23 02:53:04z",
+            " 2008-10-23T02:53:04Z ",
+            "2008-10-23T04:53:04+02:00",
+            "2008-10-23T04:53:04+0200",
+            "2008-10-23T04:53:04+02",
+            "2008-10-22T21:53:04-05:00",
+        ] {
+            assert_eq!(parse_iso8601(s), Some(t), "{s}");
+        }
+        assert_eq!(parse_iso8601("2008-10-23T02:53:04.25Z"), Some(t + 0.25));
+        for s in [
+            "2008-10-23",
+            "2008-10-23T02:53",
+            "2008-10-23T2:53:04",
+            "2008-10-23T02:53:04.",
+            "2008-10-23T02:53:04+2:00",
+            "2008-10-23T02:53:04+24:00",
+            "2008-10-23T02:53:04+02:0",
+            "2008-02-30T02:53:04Z",
+            "2008/10/23T02:53:04Z",
+            "2008-10-23X02:53:04",
+            "1224730384",
+            "",
+        ] {
+            assert_eq!(parse_iso8601(s), None, "{s}");
+        }
     }
 
     #[test]

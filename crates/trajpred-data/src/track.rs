@@ -170,6 +170,11 @@ pub struct Track {
     /// (ADS-B), the file stem (CSV); with `#k` appended for the k-th segment (k ≥ 1) after
     /// splitting at gaps.
     pub id: String,
+    /// What the trajectory belongs to, for splitting data by user or vehicle (every segment
+    /// of one trajectory, and every trajectory of one user, share it): the user folder's name
+    /// (GeoLife), the taxi id (T-Drive), the `icao24` address (ADS-B), the file stem, or
+    /// `<file stem>/<id>` for a CSV file with a track/id column.
+    pub group: String,
     /// The file it was read from.
     pub source: String,
     /// The line (JSON: record) of its first point.
@@ -275,12 +280,12 @@ impl Cleaner<'_> {
         Ok(true)
     }
 
-    /// Applies the time rule (keep the first point of a run of equal timestamps, drop points
-    /// that go back in time), splits at gaps, drops short segments and projects; appends the
-    /// tracks to `out`.
+    /// Applies the time rule (see [`time_order`]), splits at gaps, drops short segments and
+    /// projects; appends the tracks of trajectory `id`, of group `group`, to `out`.
     pub fn finish(
         &mut self,
         id: &str,
+        group: &str,
         points: Vec<RawPoint>,
         frame_kind: FrameKind,
         out: &mut Vec<Track>,
@@ -288,18 +293,13 @@ impl Cleaner<'_> {
         if points.is_empty() {
             return Ok(());
         }
+        let times: Vec<f64> = points.iter().map(|p| p.t).collect();
+        let verdicts = time_order(&times);
         let mut kept: Vec<RawPoint> = Vec::with_capacity(points.len());
-        for p in points {
-            match kept.last() {
-                Some(last) if p.t == last.t => {
-                    self.report
-                        .skip(self.file, p.line, SkipReason::RepeatedTimestamp, "");
-                }
-                Some(last) if p.t < last.t => {
-                    self.report
-                        .skip(self.file, p.line, SkipReason::TimeBackwards, "");
-                }
-                _ => kept.push(p),
+        for (p, v) in points.into_iter().zip(verdicts) {
+            match v {
+                None => kept.push(p),
+                Some(reason) => self.report.skip(self.file, p.line, reason, ""),
             }
         }
         let mut segments: Vec<Vec<RawPoint>> = Vec::new();
@@ -329,7 +329,7 @@ impl Cleaner<'_> {
             } else {
                 format!("{id}#{k}")
             };
-            let track = self.project(seg_id, &seg, frame_kind)?;
+            let track = self.project(seg_id, group, &seg, frame_kind)?;
             self.report.points_kept += seg.len();
             self.report.trajectories += 1;
             out.push(track);
@@ -337,7 +337,7 @@ impl Cleaner<'_> {
         Ok(())
     }
 
-    fn project(&self, id: String, seg: &[RawPoint], kind: FrameKind) -> Result<Track> {
+    fn project(&self, id: String, group: &str, seg: &[RawPoint], kind: FrameKind) -> Result<Track> {
         let n = seg.len();
         let dim = if self.opts.altitude { 3 } else { 2 };
         let mut axes: Vec<Vec<f64>> = (0..dim).map(|_| Vec::with_capacity(n)).collect();
@@ -394,12 +394,87 @@ impl Cleaner<'_> {
         };
         Ok(Track {
             id,
+            group: group.to_string(),
             source: self.file.to_string(),
             first_line: seg[0].line,
             frame,
             trajectory: Trajectory::from_axes(times, axes)?,
         })
     }
+}
+
+/// The time rule of one trajectory (`times` in file order, or time order for ADS-B): which
+/// points to drop, and why (`None` keeps the point).
+///
+/// The kept points are a longest subsequence of strictly increasing times, so the fewest
+/// points are dropped and none is dropped when the times already increase. Among equally
+/// long choices, each kept point is the one with the earliest time that still allows a
+/// longest choice, and the earliest in file order among equal times. Consequences: the first
+/// point of a run of equal timestamps is kept; a single point stamped far in the future
+/// (a clock glitch) is dropped alone, and the track goes on after it; a point out of order
+/// is dropped, not the rest of the file. A dropped point is
+/// [`SkipReason::RepeatedTimestamp`] if its time equals the previous kept point's,
+/// [`SkipReason::TimeBackwards`] if it is earlier, [`SkipReason::TimeOutlier`] otherwise
+/// (it is later than the next kept point: a jump forward). Times must not be NaN (the
+/// loaders only produce finite times). O(n log n).
+pub(crate) fn time_order(times: &[f64]) -> Vec<Option<SkipReason>> {
+    let n = times.len();
+    // level[i]: the length of the longest strictly increasing run of times starting at i
+    let mut level = vec![0usize; n];
+    // best[k]: the largest time starting an increasing run of length k + 1 among the points
+    // after i (strictly decreasing in k)
+    let mut best: Vec<f64> = Vec::new();
+    for i in (0..n).rev() {
+        let t = times[i];
+        let k = best.partition_point(|&b| b > t);
+        level[i] = k + 1;
+        if k == best.len() {
+            best.push(t);
+        } else {
+            best[k] = t;
+        }
+    }
+    let longest = best.len();
+    // the points of each level, in file order: along one level the times never increase
+    let mut by_level: Vec<Vec<usize>> = vec![Vec::new(); longest + 1];
+    for (i, &l) in level.iter().enumerate() {
+        by_level[l].push(i);
+    }
+    let mut keep = vec![false; n];
+    let (mut after, mut last) = (0usize, f64::NEG_INFINITY);
+    for need in (1..=longest).rev() {
+        // the candidates after the previous kept point with a later time: a prefix of the
+        // level's points past `after`; take the earliest time, the first of equal times
+        let mut pick: Option<usize> = None;
+        for &i in by_level[need].iter().filter(|&&i| i >= after) {
+            if times[i] <= last {
+                break;
+            }
+            if pick.is_none_or(|p| times[i] < times[p]) {
+                pick = Some(i);
+            }
+        }
+        // a longest run always continues (level `need` exists past `after`); stop defensively
+        let Some(i) = pick else { break };
+        keep[i] = true;
+        after = i + 1;
+        last = times[i];
+    }
+    let mut out = Vec::with_capacity(n);
+    let mut previous: Option<f64> = None;
+    for (i, &t) in times.iter().enumerate() {
+        if keep[i] {
+            previous = Some(t);
+            out.push(None);
+            continue;
+        }
+        out.push(Some(match previous {
+            Some(p) if t == p => SkipReason::RepeatedTimestamp,
+            Some(p) if t < p => SkipReason::TimeBackwards,
+            _ => SkipReason::TimeOutlier,
+        }));
+    }
+    out
 }
 
 /// Whether a file's coordinates are geodetic or Cartesian metres.
@@ -432,4 +507,88 @@ pub(crate) fn fields<const N: usize>(text: &str, sep: u8) -> Result<[&str; N], u
         }
     }
     if count == N { Ok(out) } else { Err(count) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The longest strictly increasing subsequence's length, by the quadratic recurrence.
+    fn lis(t: &[f64]) -> usize {
+        let mut best = vec![1usize; t.len()];
+        for i in 0..t.len() {
+            for j in 0..i {
+                if t[j] < t[i] {
+                    best[i] = best[i].max(best[j] + 1);
+                }
+            }
+        }
+        best.into_iter().max().unwrap_or(0)
+    }
+
+    #[test]
+    fn time_order_examples() {
+        use SkipReason::{RepeatedTimestamp as R, TimeBackwards as B, TimeOutlier as O};
+        let cases: [(&[f64], &[Option<SkipReason>]); 7] = [
+            (&[0.0, 1.0, 2.0], &[None, None, None]),
+            (&[0.0, 0.0, 1.0, 1.0], &[None, Some(R), None, Some(R)]),
+            // one far-future point, then the track goes on
+            (
+                &[0.0, 1.0, 2.0, 1e9, 3.0, 4.0],
+                &[None, None, None, Some(O), None, None],
+            ),
+            // two of them in a row
+            (
+                &[0.0, 1.0, 1e9, 1e9 + 1.0, 2.0, 3.0, 4.0],
+                &[None, None, Some(O), Some(O), None, None, None],
+            ),
+            // the outlier just before the end: the earlier time wins the tie
+            (&[0.0, 1.0, 1e9, 2.0], &[None, None, Some(O), None]),
+            // a point behind the track
+            (
+                &[0.0, 1.0, 2.0, 0.5, 3.0],
+                &[None, None, None, Some(B), None],
+            ),
+            // a restart shorter than what came before: dropped as going backwards
+            (
+                &[5.0, 6.0, 7.0, 8.0, 1.0, 2.0],
+                &[None, None, None, None, Some(B), Some(B)],
+            ),
+        ];
+        for (times, want) in cases {
+            assert_eq!(time_order(times), want, "{times:?}");
+        }
+        assert!(time_order(&[]).is_empty());
+    }
+
+    #[test]
+    fn time_order_keeps_a_longest_increasing_run_of_every_small_sequence() {
+        // every sequence of length up to 6 over 4 values
+        for len in 0..=6u32 {
+            for code in 0..4usize.pow(len) {
+                let times: Vec<f64> = (0..len)
+                    .map(|k| ((code / 4usize.pow(k)) % 4) as f64)
+                    .collect();
+                let v = time_order(&times);
+                let kept: Vec<f64> = times
+                    .iter()
+                    .zip(&v)
+                    .filter(|(_, v)| v.is_none())
+                    .map(|(t, _)| *t)
+                    .collect();
+                assert!(kept.windows(2).all(|w| w[0] < w[1]), "{times:?} {v:?}");
+                assert_eq!(kept.len(), lis(&times), "{times:?} {v:?}");
+                // the first of equal times is kept: no dropped point j of the same time could
+                // take a kept point i's place (nothing kept between them, all before j earlier)
+                let kept_at = |k: usize| v[k].is_none();
+                for i in (0..times.len()).filter(|&i| kept_at(i)) {
+                    for j in (0..i).filter(|&j| times[j] == times[i]) {
+                        let could_swap = (j + 1..i).all(|k| !kept_at(k))
+                            && (0..j).filter(|&k| kept_at(k)).all(|k| times[k] < times[i]);
+                        assert!(!could_swap, "{times:?} {v:?}");
+                    }
+                }
+            }
+        }
+    }
 }

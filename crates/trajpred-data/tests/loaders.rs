@@ -328,7 +328,8 @@ fn csv_errors() {
         csvfile::parse(&b"t,x,y\n0,0,0\n1,zz,0\n"[..], "m", &strict, &mut r),
         Err(Error::Parse { line: 3, .. })
     ));
-    // non-increasing time in the user's file: dropped and counted
+    // non-increasing time in the user's file: the fewest points are dropped, and counted;
+    // the 2 at line 3 runs ahead of the 1, 2, 3 that follow it (an outlier)
     let mut r = LoadReport::new();
     let t = csvfile::parse(
         &b"t,x,y\n0,0,0\n2,1,1\n1,2,2\n2,3,3\n3,4,4\n"[..],
@@ -337,9 +338,24 @@ fn csv_errors() {
         &mut r,
     )
     .unwrap();
-    assert_eq!(t[0].trajectory.times(), &[0.0, 2.0, 3.0]);
-    assert_eq!(lines(&r, SkipReason::TimeBackwards), vec![4]);
-    assert_eq!(lines(&r, SkipReason::RepeatedTimestamp), vec![5]);
+    check_invariant(&r);
+    assert_eq!(t[0].trajectory.times(), &[0.0, 1.0, 2.0, 3.0]);
+    assert_eq!(lines(&r, SkipReason::TimeOutlier), vec![3]);
+    assert_eq!(r.skipped(SkipReason::TimeBackwards), 0);
+    // a point behind the track (line 6) is dropped as going backwards, a repeat as repeated
+    let mut r = LoadReport::new();
+    let t = csvfile::parse(
+        &b"t,x,y\n0,0,0\n1,1,1\n1,9,9\n2,2,2\n0.5,3,3\n3,4,4\n"[..],
+        "m",
+        &o,
+        &mut r,
+    )
+    .unwrap();
+    check_invariant(&r);
+    assert_eq!(t[0].trajectory.times(), &[0.0, 1.0, 2.0, 3.0]);
+    assert_eq!(t[0].trajectory.axis(0), &[0.0, 1.0, 2.0, 4.0]);
+    assert_eq!(lines(&r, SkipReason::RepeatedTimestamp), vec![4]);
+    assert_eq!(lines(&r, SkipReason::TimeBackwards), vec![6]);
 }
 
 #[test]
@@ -385,4 +401,67 @@ fn shared_reference_projection() {
     let tr = &tracks[1].trajectory;
     assert!((tr.axis(0)[0] - want.east).abs() < 1e-9 && (tr.axis(1)[0] - want.north).abs() < 1e-9);
     assert!(tracks.iter().all(|t| t.frame == Frame::Enu(beijing)));
+}
+
+/// A fresh, empty folder under the system's temporary folder.
+fn scratch(name: &str) -> PathBuf {
+    let p = std::env::temp_dir().join(format!("trajpred-data-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&p);
+    std::fs::create_dir_all(&p).unwrap();
+    p
+}
+
+#[test]
+fn tdrive_root_folder_is_descended_into() {
+    // the dataset's layout: tdrive/taxi_log_2008_by_id/*.txt
+    let root = scratch("tdrive-root");
+    let inner = root.join(tdrive::INNER_DIR);
+    std::fs::create_dir_all(&inner).unwrap();
+    std::fs::copy(fixture("tdrive/7.txt"), inner.join("7.txt")).unwrap();
+    std::fs::write(root.join("SOURCE.md"), "not a taxi log\n").unwrap();
+    let files = tdrive::files(&root).unwrap();
+    assert_eq!(files, vec![inner.join("7.txt")]);
+    let (from_root, r1) = tdrive::load_dir(&root, &LoadOptions::tdrive()).unwrap();
+    let (from_inner, r2) = tdrive::load_dir(&inner, &LoadOptions::tdrive()).unwrap();
+    assert_eq!((r1.files_read, r1.trajectories), (1, 2));
+    assert_eq!((from_root, r1), (from_inner, r2));
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn track_groups_name_the_user_or_vehicle() {
+    // GeoLife: the root and its Data/ folder alike; the group is the user
+    let root = geolife::user_dirs(&fixture("geolife")).unwrap();
+    let data = geolife::user_dirs(&fixture("geolife/Data")).unwrap();
+    assert_eq!(root, data);
+    assert_eq!(root, vec![fixture("geolife/Data/000")]);
+    let (a, _) = geolife::load_data_dir(&fixture("geolife"), &LoadOptions::geolife()).unwrap();
+    let (b, _) = geolife::load_data_dir(&fixture("geolife/Data"), &LoadOptions::geolife()).unwrap();
+    assert_eq!(a, b);
+    let groups: Vec<(&str, &str)> = a
+        .iter()
+        .map(|t| (t.id.as_str(), t.group.as_str()))
+        .collect();
+    assert_eq!(
+        groups,
+        [("000/20081023025304", "000"), ("000/20081024020959", "000")]
+    );
+    // T-Drive: the taxi id, on every segment
+    let (t, _) = tdrive::load_file(&fixture("tdrive/7.txt"), &LoadOptions::tdrive()).unwrap();
+    let groups: Vec<(&str, &str)> = t
+        .iter()
+        .map(|t| (t.id.as_str(), t.group.as_str()))
+        .collect();
+    assert_eq!(groups, [("7", "7"), ("7#1", "7")]);
+    // ADS-B: the aircraft (icao24), whatever the callsign
+    let (t, _) = adsb::load_file(&fixture("adsb/records.json"), &LoadOptions::adsb()).unwrap();
+    let groups: Vec<&str> = t.iter().map(|t| t.group.as_str()).collect();
+    assert_eq!(groups, ["484506", "484506", "3c6444"]);
+    // CSV: the file stem
+    let (t, _) = csvfile::load_file(&fixture("csv/xy.csv"), &LoadOptions::default()).unwrap();
+    assert_eq!(t[0].group, "xy");
+    // a GeoLife user folder with no Trajectory/ gives no user; an empty root no user either
+    let empty = scratch("geolife-empty");
+    assert!(geolife::user_dirs(&empty).unwrap().is_empty());
+    let _ = std::fs::remove_dir_all(&empty);
 }
