@@ -90,7 +90,7 @@ impl Dataset {
     }
 
     /// The units of a folder of this dataset, in the order they are read: GeoLife user
-    /// folders, T-Drive taxi files, ADS-B files. `None` for a single file or a CSV.
+    /// folders, T-Drive taxi files, ADS-B or CSV files. `None` for a single file.
     fn units(self, path: &Path) -> Result<Option<Vec<PathBuf>>> {
         if path.is_file() {
             return Ok(None);
@@ -118,7 +118,7 @@ impl Dataset {
                 Some(tdrive::files(&dir).map_err(data_error)?)
             }
             Dataset::Adsb => Some(adsb::files(path).map_err(data_error)?),
-            Dataset::Csv => None,
+            Dataset::Csv => Some(csvfile::files(path).map_err(data_error)?),
         })
     }
 
@@ -129,43 +129,10 @@ impl Dataset {
             (Dataset::Geolife, false) => geolife::load_user(path, opts),
             (Dataset::Tdrive, _) => tdrive::load_file(path, opts),
             (Dataset::Adsb, _) => adsb::load_file(path, opts),
-            (Dataset::Csv, true) => csvfile::load_file(path, opts),
-            (Dataset::Csv, false) => return load_csv_dir(path, opts),
+            (Dataset::Csv, _) => csvfile::load_path(path, opts),
         }
         .map_err(data_error)
     }
-}
-
-fn load_csv_dir(dir: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadReport)> {
-    let io = |e: std::io::Error| Error::InvalidParameter {
-        name: "path",
-        reason: format!("cannot read the folder {}: {e}", dir.display()),
-    };
-    let mut files: Vec<PathBuf> = Vec::new();
-    for entry in std::fs::read_dir(dir).map_err(io)? {
-        let p = entry.map_err(io)?.path();
-        let name = p
-            .file_name()
-            .map(|n| n.to_string_lossy().to_ascii_lowercase())
-            .unwrap_or_default();
-        if p.is_file() && (name.ends_with(".csv") || name.ends_with(".csv.gz")) {
-            files.push(p);
-        }
-    }
-    files.sort();
-    if files.is_empty() {
-        return Err(Error::InvalidParameter {
-            name: "path",
-            reason: format!("{} holds no .csv or .csv.gz file", dir.display()),
-        });
-    }
-    let (mut tracks, mut report) = (Vec::new(), LoadReport::new());
-    for f in files {
-        let (t, r) = csvfile::load_file(&f, opts).map_err(data_error)?;
-        tracks.extend(t);
-        report.merge(r);
-    }
-    Ok((tracks, report))
 }
 
 fn data_error(e: trajpred_data::Error) -> Error {
@@ -220,17 +187,10 @@ pub fn load_tracks(
     })
 }
 
-/// The group a track belongs to, from its id: the user (GeoLife `user/file`), the taxi
-/// (T-Drive), the aircraft (ADS-B `icao24/callsign`) or the file (CSV): the id up to its
-/// first `/` or `#` (the loaders' segment suffix).
-pub fn group_of(track_id: &str) -> &str {
-    track_id.split(['/', '#']).next().unwrap_or(track_id)
-}
-
 /// A contiguous piece of a track, ready for evaluation.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Segment {
-    /// The user, vehicle or file it came from ([`group_of`]).
+    /// The user, vehicle or file it came from ([`Track::group`]).
     pub group: String,
     /// The track's id, with `@k` for its k-th segment (k from 0).
     pub id: String,
@@ -363,7 +323,7 @@ impl Segmentation {
             counts.points += s.len();
             let id = &tracks[ti].id;
             out.push(Segment {
-                group: group_of(id).to_string(),
+                group: tracks[ti].group.clone(),
                 id: format!("{id}@{k}"),
                 frame: tracks[ti].frame,
                 trajectory: s,
