@@ -645,7 +645,10 @@ fn run(cli: Cli) -> Result<()> {
                     .reports
                     .iter()
                     .zip(&run.fit_seconds)
-                    .map(|(r, &fit)| MethodReport {
+                    .zip(&run.labels)
+                    .map(|((r, &fit), label)| MethodReport {
+                        // the name asked for (kf-dynamic-4d), not the predictor's family name
+                        method: label.clone(),
                         fit_seconds: fit,
                         ..r[0].clone()
                     })
