@@ -352,15 +352,6 @@ fn run_grid(ds: Ds, p: &Protocol, data: &Loaded, ctx: &Context, budget: &Budget)
     })
 }
 
-fn mean(v: impl IntoIterator<Item = f64>) -> f64 {
-    let (mut s, mut n) = (0.0, 0usize);
-    for x in v {
-        s += x;
-        n += 1;
-    }
-    if n == 0 { f64::NAN } else { s / n as f64 }
-}
-
 impl Grid {
     fn index(m: Method) -> usize {
         METHODS.iter().position(|&x| x == m).unwrap_or(0)
@@ -387,10 +378,10 @@ impl Grid {
         self.run.step_accuracy(Self::index(m), k)
     }
     fn fitting_error(&self) -> f64 {
-        mean([self.error(Method::Poly1), self.error(Method::Poly2)])
+        (self.error(Method::Poly1) + self.error(Method::Poly2)) / 2.0
     }
     fn fitting_accuracy(&self) -> f64 {
-        mean([self.accuracy(Method::Poly1), self.accuracy(Method::Poly2)])
+        (self.accuracy(Method::Poly1) + self.accuracy(Method::Poly2)) / 2.0
     }
 }
 
