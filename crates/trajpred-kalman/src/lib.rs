@@ -101,6 +101,7 @@
 //! ```
 #![forbid(unsafe_code)]
 
+pub mod driver;
 pub mod error;
 pub mod filter;
 pub mod kf;

@@ -94,6 +94,7 @@
 #![forbid(unsafe_code)]
 
 pub mod cloud;
+pub mod driver;
 pub mod error;
 mod gauss;
 pub mod mkpf;

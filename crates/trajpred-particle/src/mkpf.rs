@@ -379,6 +379,33 @@ where
         &self.covariances
     }
 
+    /// The same filter (particles, weights, observation, settings) with another transition,
+    /// e.g. the model of another time step. Every particle then carries the mean of the
+    /// particles' covariances (a new `Q` changes what each particle's covariance means; their
+    /// mean is the cloud's own uncertainty estimate).
+    pub fn with_transition(&self, transition: Tr) -> Result<Self>
+    where
+        Ob: Clone,
+    {
+        let covs = &self.covariances;
+        let n = self.cloud.dim();
+        let mean_cov = covs.iter().fold(
+            OMatrix::<T, D, D>::zeros_generic(D::from_usize(n), D::from_usize(n)),
+            |a, c| a + c,
+        ) / nalgebra::convert::<f64, T>(covs.len().max(1) as f64);
+        Ok(Self::new(
+            transition,
+            self.observation.clone(),
+            self.cloud.clone(),
+            mean_cov,
+            self.points,
+        )?
+        .with_config(self.config)?
+        .with_ekf_stage(self.stage)
+        .with_particle_prior(self.prior_mode)
+        .with_ukf_variant(self.ukf_variant))
+    }
+
     /// The UKF prediction of one particle by [`ParticlePrior`].
     fn ukf_prediction(
         &self,

@@ -357,6 +357,16 @@ where
     pub fn observation(&self) -> &Ob {
         &self.observation
     }
+
+    /// The same filter (particles, weights, observation, configuration) with another
+    /// transition, e.g. the model of another time step.
+    pub fn with_transition(&self, transition: Tr) -> Result<Self>
+    where
+        Ob: Clone,
+    {
+        Self::new(transition, self.observation.clone(), self.cloud.clone())?
+            .with_config(self.config)
+    }
 }
 
 impl<T, D, M, Tr, Ob> ParticleFiltering<T, D, M> for ParticleFilter<T, D, M, Tr, Ob>

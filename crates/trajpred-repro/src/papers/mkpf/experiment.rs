@@ -16,11 +16,13 @@ use std::time::Instant;
 use trajpred_core::Gaussian;
 use trajpred_data::geodesy::{Enu, Geodetic, LocalFrame};
 use trajpred_data::{LoadOptions, Projection, adsb};
+use trajpred_kalman::driver::{self, TimeStepFilter, Timed};
 use trajpred_kalman::{
     CoordinatedTurn, Ekf, Filter, LinearObservation, LinearTransition, MerweSigmaPoints,
     NoisyTransition, Transition, TransitionJacobian, Ukf,
 };
-use trajpred_particle::{Mkpf, ParticleCloud, ParticleFilter, ParticleFiltering, ParticlePrior};
+use trajpred_particle::driver::TimedParticles;
+use trajpred_particle::{Mkpf, ParticleFilter, ParticlePrior};
 
 /// ADS-B horizontal position noise, standard deviation per axis in metres (`R = sd^2 I`): a
 /// stated physical value (NACp 8 bounds the 95% horizontal error by 30 m), not fitted.
@@ -251,7 +253,7 @@ fn cwna(q: f64, dt: f64) -> [[f64; 2]; 2] {
 }
 
 /// The constant-velocity transition `[x, vx, y, vy]` over `dt` seconds.
-pub fn cv_model(noise: &Noise, dt: f64) -> Result<LinearTransition<f64, U4>> {
+pub fn cv_model(noise: &Noise, dt: f64) -> trajpred_kalman::Result<LinearTransition<f64, U4>> {
     let b = cwna(noise.accel, dt);
     let mut f = Matrix4::identity();
     let mut q = Matrix4::zeros();
@@ -263,11 +265,11 @@ pub fn cv_model(noise: &Noise, dt: f64) -> Result<LinearTransition<f64, U4>> {
             }
         }
     }
-    Ok(LinearTransition::new(f, q)?)
+    LinearTransition::new(f, q)
 }
 
 /// The coordinated-turn transition `[x, vx, y, vy, omega]` over `dt` seconds.
-pub fn ct_model(noise: &Noise, dt: f64) -> Result<CoordinatedTurn<f64>> {
+pub fn ct_model(noise: &Noise, dt: f64) -> trajpred_kalman::Result<CoordinatedTurn<f64>> {
     let b = cwna(noise.accel, dt);
     let mut q = Matrix5::zeros();
     for o in [0usize, 2] {
@@ -278,7 +280,7 @@ pub fn ct_model(noise: &Noise, dt: f64) -> Result<CoordinatedTurn<f64>> {
         }
     }
     q[(4, 4)] = noise.turn * dt;
-    Ok(CoordinatedTurn::with_process_noise(dt, q)?)
+    CoordinatedTurn::with_process_noise(dt, q)
 }
 
 fn observation<D: DimName>(sd: f64) -> Result<LinearObservation<f64, D, U2>>
@@ -357,238 +359,50 @@ fn prepare(flight: &Flight, setup: &Setup) -> Result<Prepared> {
     })
 }
 
-/// The filter of one run, stepping from kept frame to kept frame and predicting positions.
-trait Stepper<D: DimName>
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    /// Updates with `z` after `dt` seconds.
-    fn update(&mut self, dt: f64, z: [f64; 2]) -> Result<()>;
-    /// The predicted position `dt` seconds after the last update.
-    fn position_after(&self, dt: f64) -> Result<[f64; 2]>;
-}
-
-/// The filter held by the MKPF stepper, with the time step it was built for.
-type HeldMkpf<D, Tr> = Option<(f64, Mkpf<f64, D, U2, Tr, LinearObservation<f64, D, U2>>)>;
-/// The filter held by the bootstrap stepper, with the time step it was built for.
-type HeldPf<D, Tr> = Option<(
-    f64,
-    ParticleFilter<f64, D, U2, Tr, LinearObservation<f64, D, U2>>,
-)>;
 /// The best piece so far: length, flight id, times, positions, repeated reports dropped.
 type Piece = (usize, String, Vec<f64>, Vec<[f64; 2]>, usize);
 
 /// How to build the transition of a motion model for a time step.
-type MakeModel<'a, Tr> = &'a (dyn Fn(f64) -> Result<Tr> + Sync);
+type MakeModel<'a, Tr> = &'a (dyn Fn(f64) -> trajpred_kalman::Result<Tr> + Sync);
 
-struct KalmanStepper<'a, D: DimName, Tr>
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<U2, D> + Allocator<D, U2>,
-{
-    make: MakeModel<'a, Tr>,
-    obs: LinearObservation<f64, D, U2>,
-    state: Gaussian<f64, D>,
-    unscented: bool,
-}
-
-impl<D: DimName, Tr: TransitionJacobian<f64, D>> Stepper<D> for KalmanStepper<'_, D, Tr>
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<U2, D> + Allocator<D, U2>,
-{
-    fn update(&mut self, dt: f64, z: [f64; 2]) -> Result<()> {
-        let tr = (self.make)(dt)?;
-        let z = nalgebra::Vector2::new(z[0], z[1]);
-        let step = if self.unscented {
-            let f = Ukf::new::<D, U2>(&tr, &self.obs, MerweSigmaPoints::default())?;
-            Filter::<f64, D, U2>::step(&f, &self.state, Some(&z))?
-        } else {
-            let f = Ekf::new::<f64, D, U2>(&tr, &self.obs)?;
-            Filter::<f64, D, U2>::step(&f, &self.state, Some(&z))?
-        };
-        self.state = step.posterior().clone();
-        Ok(())
-    }
-
-    fn position_after(&self, dt: f64) -> Result<[f64; 2]> {
-        let tr = (self.make)(dt)?;
-        let g = if self.unscented {
-            let f = Ukf::new::<D, U2>(&tr, &self.obs, MerweSigmaPoints::default())?;
-            Filter::<f64, D, U2>::predict(&f, &self.state)?
-        } else {
-            let f = Ekf::new::<f64, D, U2>(&tr, &self.obs)?;
-            Filter::<f64, D, U2>::predict(&f, &self.state)?
-        };
-        Ok([g.mean[0], g.mean[2]])
-    }
-}
-
-/// The weighted mean of the particles pushed `dt` seconds through the transition without
-/// noise: the expected position (the process noise has mean zero).
-fn cloud_position<D: DimName, Tr: Transition<f64, D>>(
-    cloud: &ParticleCloud<f64, D>,
-    tr: &Tr,
-) -> Result<[f64; 2]>
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    let w = cloud.weights();
-    let mut p = [0.0; 2];
-    for (x, wi) in cloud.particles().iter().zip(w) {
-        let y = tr.transition(x)?;
-        p[0] += wi * y[0];
-        p[1] += wi * y[2];
-    }
-    Ok(p)
-}
-
-struct MkpfStepper<'a, D: DimName, Tr>
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<U2, D> + Allocator<D, U2>,
-{
-    make: MakeModel<'a, Tr>,
-    obs: LinearObservation<f64, D, U2>,
-    filter: HeldMkpf<D, Tr>,
-    initial: Gaussian<f64, D>,
-    particles: usize,
-    prior: ParticlePrior,
-    rng: ChaCha8Rng,
-}
-
-impl<D, Tr> Stepper<D> for MkpfStepper<'_, D, Tr>
-where
-    D: DimName,
-    Tr: TransitionJacobian<f64, D> + NoisyTransition<f64, D> + Sync,
-    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<U2, D> + Allocator<D, U2>,
-    OVector<f64, D>: Send + Sync,
-    OMatrix<f64, D, D>: Send + Sync,
-    OMatrix<f64, U2, D>: Send + Sync,
-{
-    fn update(&mut self, dt: f64, z: [f64; 2]) -> Result<()> {
-        let points = MerweSigmaPoints::default();
-        let mut filter = match self.filter.take() {
-            None => Mkpf::<f64, D, U2, Tr, LinearObservation<f64, D, U2>>::from_gaussian(
-                (self.make)(dt)?,
-                self.obs.clone(),
-                &self.initial,
-                self.particles,
-                points,
-                &mut self.rng,
-            )?
-            .with_particle_prior(self.prior),
-            Some((old_dt, f)) if old_dt == dt => f,
-            Some((_, f)) => {
-                // a new time step needs a new transition (and Q): rebuild, every particle
-                // carrying the mean of the particles' covariances
-                let covs = f.covariances();
-                let mean_cov = covs
-                    .iter()
-                    .fold(OMatrix::<f64, D, D>::zeros(), |a, c| a + c)
-                    / covs.len().max(1) as f64;
-                Mkpf::<f64, D, U2, Tr, LinearObservation<f64, D, U2>>::new(
-                    (self.make)(dt)?,
-                    self.obs.clone(),
-                    ParticleFiltering::<f64, D, U2>::cloud(&f).clone(),
-                    mean_cov,
-                    points,
-                )?
-                .with_particle_prior(self.prior)
-            }
-        };
-        ParticleFiltering::<f64, D, U2>::step(
-            &mut filter,
-            Some(&nalgebra::Vector2::new(z[0], z[1])),
-            &mut self.rng,
-        )?;
-        self.filter = Some((dt, filter));
-        Ok(())
-    }
-
-    fn position_after(&self, dt: f64) -> Result<[f64; 2]> {
-        let (_, f) = self
-            .filter
-            .as_ref()
-            .ok_or_else(|| experiment_err("MKPF predicted before its first update"))?;
-        cloud_position(ParticleFiltering::<f64, D, U2>::cloud(f), &(self.make)(dt)?)
-    }
-}
-
-struct BootstrapStepper<'a, D: DimName, Tr>
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<U2, D> + Allocator<D, U2>,
-{
-    make: MakeModel<'a, Tr>,
-    obs: LinearObservation<f64, D, U2>,
-    filter: HeldPf<D, Tr>,
-    initial: Gaussian<f64, D>,
-    particles: usize,
-    rng: ChaCha8Rng,
-}
-
-impl<D, Tr> Stepper<D> for BootstrapStepper<'_, D, Tr>
-where
-    D: DimName,
-    Tr: TransitionJacobian<f64, D> + Sync,
-    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<U2, D> + Allocator<D, U2>,
-    OVector<f64, D>: Send + Sync,
-    OMatrix<f64, D, D>: Send + Sync,
-    OMatrix<f64, U2, D>: Send + Sync,
-{
-    fn update(&mut self, dt: f64, z: [f64; 2]) -> Result<()> {
-        let mut filter = match self.filter.take() {
-            None => ParticleFilter::<f64, D, U2, Tr, LinearObservation<f64, D, U2>>::from_gaussian(
-                (self.make)(dt)?,
-                self.obs.clone(),
-                &self.initial,
-                self.particles,
-                &mut self.rng,
-            )?,
-            Some((old_dt, f)) if old_dt == dt => f,
-            Some((_, f)) => ParticleFilter::<f64, D, U2, Tr, LinearObservation<f64, D, U2>>::new(
-                (self.make)(dt)?,
-                self.obs.clone(),
-                ParticleFiltering::<f64, D, U2>::cloud(&f).clone(),
-            )?,
-        };
-        ParticleFiltering::<f64, D, U2>::step(
-            &mut filter,
-            Some(&nalgebra::Vector2::new(z[0], z[1])),
-            &mut self.rng,
-        )?;
-        self.filter = Some((dt, filter));
-        Ok(())
-    }
-
-    fn position_after(&self, dt: f64) -> Result<[f64; 2]> {
-        let (_, f) = self
-            .filter
-            .as_ref()
-            .ok_or_else(|| experiment_err("PF predicted before its first update"))?;
-        cloud_position(ParticleFiltering::<f64, D, U2>::cloud(f), &(self.make)(dt)?)
-    }
-}
-
-/// Runs the stepper over the flight: update at each kept frame after the first, predict the
-/// frames until the next kept frame. The frames before the second kept frame are not
-/// evaluated (the filters start from one position and no velocity).
-fn drive<D: DimName>(
+/// Runs a filter over the flight through the filter driver: update at each kept frame after
+/// the first, predict the frames until the next kept frame from there. The frames before the
+/// second kept frame are not evaluated (the filters start from one position and no velocity).
+fn drive_kept<D, F>(
     prep: &Prepared,
     times: &[f64],
-    stepper: &mut dyn Stepper<D>,
+    filter: &mut F,
 ) -> Result<(Vec<usize>, Vec<[f64; 2]>)>
 where
+    D: DimName,
+    F: TimeStepFilter<f64, D, U2>,
+    ReproError: From<F::Error>,
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
+    let kept_times: Vec<f64> = prep.kept.iter().map(|&k| times[k]).collect();
+    let kept_z: Vec<Option<nalgebra::Vector2<f64>>> = prep
+        .kept
+        .iter()
+        .map(|&k| {
+            Some(nalgebra::Vector2::new(
+                prep.observed[k][0],
+                prep.observed[k][1],
+            ))
+        })
+        .collect();
     let mut frames = Vec::new();
     let mut predicted = Vec::new();
-    for w in prep.kept.windows(2) {
-        let (prev, k) = (w[0], w[1]);
-        stepper.update(times[k] - times[prev], prep.observed[k])?;
-        let end = prep.kept.iter().find(|&&j| j > k).copied().unwrap_or(k + 1);
-        for j in k + 1..end {
-            predicted.push(stepper.position_after(times[j] - times[k])?);
+    driver::drive::<f64, D, U2, F, _>(filter, &kept_times, &kept_z, |i, f| {
+        let k = prep.kept[i];
+        let end = prep.kept.get(i + 1).copied().unwrap_or(k + 1);
+        let offsets: Vec<f64> = (k + 1..end).map(|j| times[j] - times[k]).collect();
+        for (j, g) in (k + 1..end).zip(f.forecast_at(&offsets)?) {
+            predicted.push([g.mean[0], g.mean[2]]);
             frames.push(j);
         }
-    }
+        Ok(())
+    })
+    .map_err(ReproError::from)?;
     Ok((frames, predicted))
 }
 
@@ -611,36 +425,59 @@ where
 {
     let obs = observation::<D>(setup.position_sd)?;
     let initial = initial::<D>(prep.observed[0], setup, noise);
-    let rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut stepper: Box<dyn Stepper<D> + '_> = match method {
-        Method::Ukf | Method::Ekf => Box::new(KalmanStepper {
-            make,
-            obs,
-            state: initial,
-            unscented: method == Method::Ukf,
-        }),
-        Method::Mkpf(particles) | Method::MkpfConditioned(particles) => Box::new(MkpfStepper {
-            make,
-            obs,
-            filter: None,
-            initial,
-            particles,
-            prior: match method {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let times = &flight.times;
+    // the particle filters are built for the first interval between kept frames
+    let first_dt = match prep.kept.as_slice() {
+        [a, b, ..] => times[*b] - times[*a],
+        _ => return Ok((Vec::new(), Vec::new())),
+    };
+    match method {
+        Method::Ukf => {
+            let make_ukf =
+                |dt: f64| Ukf::new::<D, U2>(make(dt)?, obs.clone(), MerweSigmaPoints::default());
+            drive_kept(prep, times, &mut Timed::new(make_ukf, initial))
+        }
+        Method::Ekf => {
+            let make_ekf = |dt: f64| Ekf::new::<f64, D, U2>(make(dt)?, obs.clone());
+            drive_kept(prep, times, &mut Timed::new(make_ekf, initial))
+        }
+        Method::Mkpf(particles) | Method::MkpfConditioned(particles) => {
+            let prior = match method {
                 Method::MkpfConditioned(_) => ParticlePrior::Conditioned,
                 _ => ParticlePrior::Carried,
-            },
-            rng,
-        }),
-        Method::Bootstrap(particles) => Box::new(BootstrapStepper {
-            make,
-            obs,
-            filter: None,
-            initial,
-            particles,
-            rng,
-        }),
-    };
-    drive(prep, &flight.times, stepper.as_mut())
+            };
+            let mkpf = Mkpf::<f64, D, U2, Tr, LinearObservation<f64, D, U2>>::from_gaussian(
+                make(first_dt)?,
+                obs,
+                &initial,
+                particles,
+                MerweSigmaPoints::default(),
+                &mut rng,
+            )?
+            .with_particle_prior(prior);
+            drive_kept(
+                prep,
+                times,
+                &mut TimedParticles::new(make, mkpf, first_dt, rng),
+            )
+        }
+        Method::Bootstrap(particles) => {
+            let pf =
+                ParticleFilter::<f64, D, U2, Tr, LinearObservation<f64, D, U2>>::from_gaussian(
+                    make(first_dt)?,
+                    obs,
+                    &initial,
+                    particles,
+                    &mut rng,
+                )?;
+            drive_kept(
+                prep,
+                times,
+                &mut TimedParticles::new(make, pf, first_dt, rng),
+            )
+        }
+    }
 }
 
 /// Runs one method with one motion model and noise on the flight (the seed drives the particle
@@ -693,7 +530,7 @@ fn kept_log_likelihood(
         times: &[f64],
         setup: &Setup,
         noise: &Noise,
-        make: &dyn Fn(f64) -> Result<Tr>,
+        make: &dyn Fn(f64) -> trajpred_kalman::Result<Tr>,
     ) -> Result<f64>
     where
         D: DimName,

@@ -1,0 +1,197 @@
+//! The filter driver: one small trait that every filter of trajpred implements, and one loop
+//! that runs any of them over a track sampled at irregular times, with missing observations.
+//!
+//! A [`TimeStepFilter`] holds its current estimate and advances it by a time step `dt`
+//! (building whatever model that step needs), updates it with an observation when there is
+//! one, and forecasts at time offsets after it. [`drive`] is the loop; [`Timed`] makes any
+//! Gaussian [`Filter`] (KF, EKF, UKF, augmented UKF) a `TimeStepFilter` from a function that
+//! builds the filter for a time step, and `trajpred-particle` does the same for its particle
+//! filters (the MKPF proposal needs the observation inside the step, which is why the trait
+//! advances and updates in one call).
+//!
+//! ```
+//! use nalgebra::{Vector2, Vector4};
+//! use trajpred_core::Gaussian;
+//! use trajpred_kalman::driver::{Timed, TimeStepFilter, drive};
+//! use trajpred_kalman::motion::{StateOrder, constant_velocity};
+//! use trajpred_kalman::{Kf, KalmanError, LinearObservation, LinearTransition};
+//! use nalgebra::{Matrix2, Matrix2x4, Matrix4, U4};
+//!
+//! // constant velocity in 2-D, white-noise acceleration; the model is built for each step
+//! let make = |dt: f64| -> Result<_, KalmanError> {
+//!     let cv = constant_velocity::<f64, U4>(2, dt, 0.5, StateOrder::PositionsFirst)?;
+//!     let obs = LinearObservation::new(
+//!         Matrix2x4::new(1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0),
+//!         Matrix2::identity() * 4.0,
+//!     )?;
+//!     Kf::new(cv, obs)
+//! };
+//! let start = Gaussian::new(Vector4::new(0.0, 0.0, 1.0, 0.0), Matrix4::identity() * 10.0)?;
+//! let mut f = Timed::new(make, start);
+//! // fixes at irregular times, one missing
+//! let times = [0.0, 1.0, 2.5, 3.0, 5.0];
+//! let z = [None, Some(Vector2::new(1.1, 0.0)), None, Some(Vector2::new(3.0, 0.1)),
+//!          Some(Vector2::new(5.1, -0.1))];
+//! let estimates = drive(&mut f, &times, &z, |_, _| Ok(()))?;
+//! assert_eq!(estimates.len(), 4); // one per time after the first
+//! let ahead = f.forecast_at(&[1.0, 2.0])?;
+//! assert!((ahead[1].mean[0] - 7.0).abs() < 1.0);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use crate::error::{KalmanError, Result};
+use crate::filter::Filter;
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim, OVector, RealField};
+use trajpred_core::Gaussian;
+
+/// A filter that the driver can run: it holds its estimate, advances it over a time step
+/// (and updates it when an observation comes), and forecasts ahead of it.
+pub trait TimeStepFilter<T: RealField + Copy, D: Dim, M: Dim>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M>,
+{
+    /// The errors of the filter; the driver's own errors (a bad time step) convert into it.
+    type Error: From<KalmanError>;
+
+    /// Advances the estimate `dt > 0` seconds, then updates it with `z` when it is `Some`.
+    fn advance(&mut self, dt: T, z: Option<&OVector<T, M>>)
+    -> std::result::Result<(), Self::Error>;
+
+    /// The current estimate.
+    fn estimate(&self) -> std::result::Result<Gaussian<T, D>, Self::Error>;
+
+    /// The forecasts `offsets[j]` seconds after the current estimate (each offset > 0, in
+    /// any order), leaving the filter as it is. Each is one prediction over the whole offset.
+    fn forecast_at(&self, offsets: &[T]) -> std::result::Result<Vec<Gaussian<T, D>>, Self::Error>;
+}
+
+/// Checks a time step: finite and positive.
+pub fn check_dt<T: RealField + Copy>(dt: T, what: &'static str) -> Result<()> {
+    if dt.is_finite() && dt > T::zero() {
+        Ok(())
+    } else {
+        Err(KalmanError::InvalidParameter {
+            name: what,
+            reason: format!("time step must be finite and positive, got {dt}"),
+        })
+    }
+}
+
+/// The one loop: the filter's estimate is at `times[0]`; for each later time it advances by
+/// the interval and updates with the observation there (`None`: missing), then calls
+/// `after(k, filter)` (for example to forecast from there). Returns the estimate after each
+/// time `times[1..]`. `observations[0]` is not used (the estimate at `times[0]` is the
+/// filter's starting point); times must increase strictly.
+pub fn drive<T, D, M, F, A>(
+    filter: &mut F,
+    times: &[T],
+    observations: &[Option<OVector<T, M>>],
+    mut after: A,
+) -> std::result::Result<Vec<Gaussian<T, D>>, F::Error>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    F: TimeStepFilter<T, D, M> + ?Sized,
+    A: FnMut(usize, &F) -> std::result::Result<(), F::Error>,
+    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M>,
+{
+    if times.len() != observations.len() {
+        return Err(KalmanError::DimensionMismatch {
+            what: "times vs observations",
+            expected: times.len(),
+            got: observations.len(),
+        }
+        .into());
+    }
+    let mut out = Vec::with_capacity(times.len().saturating_sub(1));
+    for k in 1..times.len() {
+        let dt = times[k] - times[k - 1];
+        check_dt(dt, "times")?;
+        filter.advance(dt, observations[k].as_ref())?;
+        out.push(filter.estimate()?);
+        after(k, filter)?;
+    }
+    Ok(out)
+}
+
+/// A Gaussian [`Filter`] run by time steps: `make(dt)` builds the filter (its transition and
+/// noise) for a step of `dt` seconds; the last one built is kept and reused while the step
+/// stays the same, so a regularly sampled track builds it once.
+#[derive(Debug, Clone)]
+pub struct Timed<T: RealField, D: Dim, F, Make>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    make: Make,
+    state: Gaussian<T, D>,
+    built: Option<(T, F)>,
+}
+
+impl<T, D, F, Make> Timed<T, D, F, Make>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    /// A filter starting from `state`, with `make` building the filter for each time step.
+    pub fn new(make: Make, state: Gaussian<T, D>) -> Self {
+        Timed {
+            make,
+            state,
+            built: None,
+        }
+    }
+
+    /// The current estimate, by reference.
+    pub fn state(&self) -> &Gaussian<T, D> {
+        &self.state
+    }
+}
+
+impl<T, D, M, F, Make> TimeStepFilter<T, D, M> for Timed<T, D, F, Make>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    F: Filter<T, D, M>,
+    Make: Fn(T) -> Result<F>,
+    DefaultAllocator: Allocator<D>
+        + Allocator<D, D>
+        + Allocator<M>
+        + Allocator<M, M>
+        + Allocator<D, M>
+        + Allocator<M, D>,
+{
+    type Error = KalmanError;
+
+    fn advance(&mut self, dt: T, z: Option<&OVector<T, M>>) -> Result<()> {
+        check_dt(dt, "dt")?;
+        let filter = match self.built.take() {
+            Some((built_dt, f)) if built_dt == dt => f,
+            _ => (self.make)(dt)?,
+        };
+        let result = filter.step(&self.state, z);
+        self.built = Some((dt, filter));
+        self.state = result?.posterior().clone();
+        Ok(())
+    }
+
+    fn estimate(&self) -> Result<Gaussian<T, D>> {
+        Ok(self.state.clone())
+    }
+
+    fn forecast_at(&self, offsets: &[T]) -> Result<Vec<Gaussian<T, D>>> {
+        offsets
+            .iter()
+            .map(|&dt| {
+                check_dt(dt, "forecast offset")?;
+                match &self.built {
+                    Some((built_dt, f)) if *built_dt == dt => f.predict(&self.state),
+                    _ => (self.make)(dt)?.predict(&self.state),
+                }
+            })
+            .collect()
+    }
+}
