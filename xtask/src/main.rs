@@ -2,15 +2,23 @@
 //! `trajpred-repro`).
 //!
 //! ```text
-//! cargo xtask reproduce [--paper gskf|kf-dynamic|mkpf|kfu-lstm|all] [--quick] [--check]
+//! cargo xtask reproduce [--paper <slug>|all] [--quick] [--check | --bless]
 //!                       [--data DIR] [--out DIR] [--seed N]
 //! ```
+//!
+//! The slugs are those of `trajpred_repro::Paper::ALL`. A run is written to `--out`
+//! (`target/reproduce`, or `target/reproduce-quick` with `--quick`); `docs/results/` is only
+//! read by `--check` and only written by `--bless`.
 #![allow(clippy::print_stdout)]
 
 use anyhow::{Context as _, Result, bail};
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::builder::{PossibleValuesParser, TypedValueParser};
+use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
-use trajpred_repro::{Context, Paper, check_paper, reproduce_into};
+use std::time::Instant;
+use trajpred_repro::{
+    Context, Paper, ReproError, bless, check_paper, run_info, run_paper, write_run,
+};
 
 #[derive(Parser)]
 #[command(name = "cargo xtask", about = "trajpred project automation")]
@@ -19,58 +27,50 @@ struct Cli {
     command: Command,
 }
 
+/// The papers `--paper` selected.
+#[derive(Clone)]
+struct Selection(Vec<Paper>);
+
+/// `--paper`: a slug of `Paper::ALL`, or `all`; clap lists these values in the help.
+fn paper_parser() -> impl TypedValueParser<Value = Selection> {
+    let values = Paper::ALL.iter().map(|p| p.slug()).chain(["all"]);
+    PossibleValuesParser::new(values)
+        .map(|s| Selection(Paper::from_slug(&s).map_or_else(|| Paper::ALL.to_vec(), |p| vec![p])))
+}
+
 #[derive(Subcommand)]
 enum Command {
-    /// Regenerate the tables and figures of the four papers under docs/results/.
+    /// Regenerate the tables and figures of the papers (under target/reproduce by default);
+    /// --check compares them with docs/results/, --bless replaces docs/results/ with them.
     Reproduce {
-        /// Which paper to reproduce.
-        #[arg(long, value_enum, default_value_t = Which::All)]
-        paper: Which,
+        /// Which paper to reproduce (`all`: every paper, in order).
+        #[arg(long, default_value = "all", value_parser = paper_parser())]
+        paper: Selection,
         /// A reduced run (fewer seeds, epochs and trajectories) that finishes in under a
-        /// minute; written to target/reproduce-quick unless --out is given.
+        /// minute; written to target/reproduce-quick unless --out is given. Cannot be blessed.
         #[arg(long)]
         quick: bool,
-        /// Run, then compare the tables with the committed ones under docs/results/ within
-        /// each column's stated tolerance, instead of overwriting them.
-        #[arg(long)]
+        /// Then compare the run with the one committed under docs/results/: fail, listing
+        /// every difference, when a number is outside its column's tolerance, a label or paper
+        /// figure changed, a claim's verdict changed, or a table, row, column, figure or claim
+        /// is on one side only.
+        #[arg(long, conflicts_with = "bless")]
         check: bool,
+        /// Then copy the run into docs/results/ (replacing each reproduced paper's folder) and
+        /// rewrite docs/results/README.md: the only way docs/results/ changes.
+        #[arg(long, conflicts_with = "quick")]
+        bless: bool,
         /// Folder holding the real datasets (geolife/, tdrive/, adsb-traffic/).
         #[arg(long, default_value = "../shared/data")]
         data: PathBuf,
-        /// Where to write the results (default docs/results, or target/reproduce-quick with
-        /// --quick).
+        /// Where to write the run (default target/reproduce, or target/reproduce-quick with
+        /// --quick); each paper in <out>/<slug>/, with an index <out>/README.md.
         #[arg(long)]
         out: Option<PathBuf>,
         /// Base seed of every random choice.
         #[arg(long, default_value_t = Context::default().seed)]
         seed: u64,
     },
-}
-
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum Which {
-    /// MSTPM-GSKF: group sparse coding + improved Kalman filter (SPEC A).
-    Gskf,
-    /// Dynamic trajectory prediction with a Kalman filter (SPEC B).
-    KfDynamic,
-    /// MKPF: particle filter with a UKF+EKF proposal (SPEC C).
-    Mkpf,
-    /// KFU-LSTM-Net: Kalman-filter-unfolded LSTM (SPEC D).
-    KfuLstm,
-    /// All four.
-    All,
-}
-
-impl Which {
-    fn papers(self) -> Vec<Paper> {
-        match self {
-            Which::Gskf => vec![Paper::Gskf],
-            Which::KfDynamic => vec![Paper::KfDynamic],
-            Which::Mkpf => vec![Paper::Mkpf],
-            Which::KfuLstm => vec![Paper::KfuLstm],
-            Which::All => Paper::ALL.to_vec(),
-        }
-    }
 }
 
 /// The workspace root (xtask lives one level below it).
@@ -105,22 +105,28 @@ fn revision(root: &Path) -> String {
     }
 }
 
+/// Makes a relative path relative to the workspace root.
+fn under(root: &Path, path: PathBuf) -> PathBuf {
+    if path.is_relative() {
+        root.join(path)
+    } else {
+        path
+    }
+}
+
 fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Reproduce {
             paper,
             quick,
             check,
+            bless: blessing,
             data,
             out,
             seed,
         } => {
             let root = root();
-            let data = if data.is_relative() {
-                root.join(data)
-            } else {
-                data
-            };
+            let data = under(&root, data);
             if !data.is_dir() {
                 eprintln!(
                     "note: no data folder at {}; the real-data experiments will say what to \
@@ -135,40 +141,24 @@ fn main() -> Result<()> {
                 progress: true,
             };
             let committed = root.join("docs").join("results");
-            let out = out.unwrap_or_else(|| {
-                if quick {
-                    root.join("target").join("reproduce-quick")
+            let out = match out {
+                Some(dir) => under(&root, dir),
+                None => root.join("target").join(if quick {
+                    "reproduce-quick"
                 } else {
-                    committed.clone()
-                }
-            });
+                    "reproduce"
+                }),
+            };
             let rev = revision(&root);
-            let mut failures = 0;
-            for p in paper.papers() {
+            let start = Instant::now();
+            let mut failed = Vec::new();
+            for p in paper.0 {
                 eprintln!("== {}", p.title());
-                if check {
-                    let (result, diffs) = check_paper(p, &ctx, &committed)
-                        .with_context(|| format!("reproducing {}", p.slug()))?;
-                    for t in &result.tables {
-                        println!("{}", t.to_markdown());
-                    }
-                    if diffs.is_empty() {
-                        println!(
-                            "check {}: {} tables agree with docs/results/{} within their tolerances",
-                            p.slug(),
-                            result.tables.len(),
-                            p.slug()
-                        );
-                    } else {
-                        failures += diffs.len();
-                        for d in &diffs {
-                            println!("check {}: {d}", p.slug());
-                        }
-                    }
-                    continue;
-                }
-                let info = reproduce_into(p, &ctx, &out, &rev)
-                    .with_context(|| format!("reproducing {}", p.slug()))?;
+                let (result, wall) =
+                    run_paper(p, &ctx).with_context(|| format!("reproducing {}", p.slug()))?;
+                let info = run_info(p, &ctx, &result, wall, &rev);
+                write_run(p, &result, &info, &out)
+                    .with_context(|| format!("writing {} under {}", p.slug(), out.display()))?;
                 let readme = out.join(p.slug()).join("README.md");
                 let text = std::fs::read_to_string(&readme)
                     .with_context(|| format!("reading {}", readme.display()))?;
@@ -179,12 +169,58 @@ fn main() -> Result<()> {
                 eprintln!(
                     "{}: {:.1} s, written to {}",
                     p.slug(),
-                    info.wall_seconds,
+                    wall,
                     out.join(p.slug()).display()
                 );
+                if check {
+                    match check_paper(p, &result, &committed) {
+                        Ok(()) => println!(
+                            "check {}: {} tables, {} figures and {} claims agree with \
+                             docs/results/{} within their tolerances",
+                            p.slug(),
+                            result.tables.len(),
+                            result.figures.len(),
+                            result.claims.len(),
+                            p.slug()
+                        ),
+                        Err(ReproError::CheckFailed { differences, .. }) => {
+                            println!(
+                                "check {}: {} difference(s) from docs/results/{}:",
+                                p.slug(),
+                                differences.len(),
+                                p.slug()
+                            );
+                            for d in &differences {
+                                println!("  - {d}");
+                            }
+                            failed.push((p.slug(), differences.len()));
+                        }
+                        Err(e) => {
+                            return Err(e).with_context(|| format!("checking {}", p.slug()));
+                        }
+                    }
+                }
+                if blessing {
+                    bless(p, &out, &committed).with_context(|| {
+                        format!("blessing {} into {}", p.slug(), committed.display())
+                    })?;
+                    eprintln!(
+                        "{}: blessed into {}",
+                        p.slug(),
+                        committed.join(p.slug()).display()
+                    );
+                }
             }
-            if failures > 0 {
-                bail!("{failures} difference(s) from the committed results");
+            eprintln!("total: {:.1} s", start.elapsed().as_secs_f64());
+            if !failed.is_empty() {
+                let which: Vec<String> = failed
+                    .iter()
+                    .map(|(slug, n)| format!("{slug} ({n})"))
+                    .collect();
+                bail!(
+                    "--check failed: differences from docs/results in {}",
+                    which.join(", ")
+                );
             }
             Ok(())
         }

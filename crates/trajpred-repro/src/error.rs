@@ -1,6 +1,17 @@
 //! The error type of the reproduction.
 
+use crate::report::Difference;
+use std::fmt::Write as _;
 use std::path::PathBuf;
+
+/// One difference a line.
+fn list(differences: &[Difference]) -> String {
+    let mut s = String::new();
+    for d in differences {
+        let _ = write!(s, "\n  - {d}");
+    }
+    s
+}
 
 /// What can go wrong while reproducing a paper or checking a run.
 #[derive(Debug, thiserror::Error)]
@@ -47,16 +58,20 @@ pub enum ReproError {
         /// What was wrong.
         reason: String,
     },
-    /// `--check`: a fresh run differs from the committed results.
+    /// `--check`: a fresh run differs from the committed one (every difference is listed).
     #[error(
-        "{} cell(s) differ from the committed results; first: {first}",
-        differences
+        "{paper}: {} difference(s) from the run committed in {}:{}",
+        .differences.len(),
+        .committed.display(),
+        list(.differences)
     )]
     CheckFailed {
-        /// How many cells differ (or files are missing).
-        differences: usize,
-        /// The first difference, in words.
-        first: String,
+        /// The paper's slug.
+        paper: String,
+        /// The committed run's folder.
+        committed: PathBuf,
+        /// Every difference, in the order [`crate::report::compare_run`] finds them.
+        differences: Vec<Difference>,
     },
 }
 

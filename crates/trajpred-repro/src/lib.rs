@@ -4,8 +4,12 @@
 //! regenerates a paper's tables and figures with trajpred's own implementations and returns
 //! them with the paper's reported figure beside ours ([`report::Table`]), the paper's claims
 //! decided from the run ([`report::Claim`]) and notes on why numbers differ.
-//! `cargo xtask reproduce` is a thin command over [`run_paper`], [`report::write_paper`],
-//! [`report::write_index`] and [`report::compare_with_committed`].
+//! `cargo xtask reproduce` is a thin command over [`run_paper`], [`write_run`] (which writes a
+//! run under `target/reproduce/` by default), [`check_paper`] (`--check`: compares a fresh run
+//! with the one committed under `docs/results/` and fails on any difference beyond a column's
+//! tolerance, or any table, row, column, figure or claim on one side only) and [`bless`]
+//! (`--bless`: the only way `docs/results/` changes). Every file is written atomically
+//! ([`report::write_atomic`]).
 //!
 //! | paper | module | SPEC |
 //! |---|---|---|
@@ -24,7 +28,9 @@ pub mod papers;
 pub mod report;
 
 pub use error::{ReproError, Result};
-pub use report::{Claim, Column, ColumnKind, Figure, PaperResult, RunInfo, Table, Value};
+pub use report::{
+    Claim, Column, ColumnKind, Difference, Figure, PaperResult, RunInfo, Table, Value,
+};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -197,12 +203,18 @@ pub fn run_info(
     }
 }
 
+/// Writes a finished run of `paper` under `root/<slug>/` (replacing an earlier run there), then
+/// refreshes the index `root/README.md`.
+pub fn write_run(paper: Paper, result: &PaperResult, info: &RunInfo, root: &Path) -> Result<()> {
+    report::write_paper(result, info, &root.join(paper.slug()))?;
+    write_index(root)
+}
+
 /// Runs `paper` and writes its results under `root/<slug>/`, then refreshes `root/README.md`.
 pub fn reproduce_into(paper: Paper, ctx: &Context, root: &Path, revision: &str) -> Result<RunInfo> {
     let (result, wall) = run_paper(paper, ctx)?;
     let info = run_info(paper, ctx, &result, wall, revision);
-    report::write_paper(&result, &info, &root.join(paper.slug()))?;
-    write_index(root)?;
+    write_run(paper, &result, &info, root)?;
     Ok(info)
 }
 
@@ -215,10 +227,20 @@ pub fn write_index(root: &Path) -> Result<()> {
     report::write_index(root, &explanations)
 }
 
-/// Runs `paper` and compares its tables with those committed under `root/<slug>/`; returns
-/// the fresh result and the differences (empty when it agrees within every column's tolerance).
-pub fn check_paper(paper: Paper, ctx: &Context, root: &Path) -> Result<(PaperResult, Vec<String>)> {
-    let (result, _) = run_paper(paper, ctx)?;
-    let diffs = report::compare_with_committed(&result.tables, &root.join(paper.slug()))?;
-    Ok((result, diffs))
+/// `--check`: compares a fresh run of `paper` with the run committed under
+/// `committed_root/<slug>/` (see [`report::compare_run`] for what is compared and how) and
+/// returns [`ReproError::CheckFailed`], listing every difference, unless they agree.
+pub fn check_paper(paper: Paper, result: &PaperResult, committed_root: &Path) -> Result<()> {
+    report::check_run(paper.slug(), result, &committed_root.join(paper.slug()))
+}
+
+/// `--bless`: replaces the run of `paper` under `committed_root/<slug>/` with the one written
+/// under `fresh_root/<slug>/` (files the fresh run did not write are removed), then rewrites
+/// the index `committed_root/README.md`.
+pub fn bless(paper: Paper, fresh_root: &Path, committed_root: &Path) -> Result<()> {
+    report::replace_run(
+        &fresh_root.join(paper.slug()),
+        &committed_root.join(paper.slug()),
+    )?;
+    write_index(committed_root)
 }

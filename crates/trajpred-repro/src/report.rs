@@ -1,5 +1,6 @@
-//! Tables, figures and claims: what a paper's runner returns, and how it is written under
-//! `docs/results/`.
+//! Tables, figures and claims: what a paper's runner returns, how a run is written (every file
+//! atomically, [`write_atomic`]), compared with the committed one ([`compare_run`], `--check`)
+//! and copied over it ([`replace_run`], `--bless`).
 //!
 //! Every number in a [`Table`] comes from a run, except the cells of [`ColumnKind::Paper`]
 //! columns, which hold the figure the paper itself reports (from SPEC), so that ours can be
@@ -9,6 +10,7 @@ use crate::error::{ReproError, Result, io_err};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 use trajpred::plot::{Chart, write_chart};
 
 /// One cell of a table.
@@ -346,13 +348,128 @@ pub struct RunInfo {
     pub figures: Vec<(String, String)>,
 }
 
-fn write(path: &Path, text: &str) -> Result<()> {
-    std::fs::write(path, text).map_err(io_err(path))
+static TEMP_SERIAL: AtomicU64 = AtomicU64::new(0);
+
+/// The temporary file beside `path` that [`write_atomic_with`] writes first: hidden, in the same
+/// folder (so the final rename stays on one file system), unique to this process and call, and
+/// ending in the destination's extension (the plot writer chooses the format from it), e.g.
+/// `.fig1.svg.tmp-4242-7.svg`. `.gitignore` ignores the pattern `.*.tmp-*`.
+fn temp_path(path: &Path) -> Result<PathBuf> {
+    let name = path.file_name().ok_or_else(|| ReproError::Io {
+        path: path.to_path_buf(),
+        source: std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file path"),
+    })?;
+    let ext = path
+        .extension()
+        .map_or_else(|| "tmp".into(), |e| e.to_string_lossy());
+    let serial = TEMP_SERIAL.fetch_add(1, Ordering::Relaxed);
+    Ok(path.with_file_name(format!(
+        ".{}.tmp-{}-{serial}.{ext}",
+        name.to_string_lossy(),
+        std::process::id()
+    )))
+}
+
+/// Writes `path` atomically: `write` is handed a temporary path in the same folder and must
+/// write the whole file there; the temporary file is then flushed to disk and renamed over
+/// `path`. Readers (and a later run) see either the old file or the new one, never a partial
+/// one. When `write`, the flush or the rename fails, the temporary file is removed, `path` keeps
+/// its old content and the error is returned.
+pub fn write_atomic_with<F>(path: &Path, write: F) -> Result<()>
+where
+    F: FnOnce(&Path) -> Result<()>,
+{
+    let tmp = temp_path(path)?;
+    let outcome = write(&tmp)
+        .and_then(|()| {
+            std::fs::OpenOptions::new()
+                .write(true)
+                .open(&tmp)
+                .and_then(|f| f.sync_all())
+                .map_err(io_err(&tmp))
+        })
+        .and_then(|()| std::fs::rename(&tmp, path).map_err(io_err(path)));
+    if outcome.is_err() {
+        // best effort: the temporary file may not exist if `write` failed before creating it
+        let _ = std::fs::remove_file(&tmp);
+    }
+    outcome
+}
+
+/// Writes `bytes` to `path` atomically (see [`write_atomic_with`]).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomic_with(path, |tmp| std::fs::write(tmp, bytes).map_err(io_err(tmp)))
+}
+
+impl RunInfo {
+    /// The names of the files [`write_paper`] writes for this run, in the paper's folder:
+    /// `README.md`, `run.json`, `<table>.md` and `<table>.csv` per table, `<figure>.svg` and
+    /// `<figure>.png` per figure.
+    pub fn files(&self) -> Vec<String> {
+        let mut files = vec!["README.md".to_string(), "run.json".to_string()];
+        for (id, _) in &self.tables {
+            files.push(format!("{id}.md"));
+            files.push(format!("{id}.csv"));
+        }
+        for (id, _) in &self.figures {
+            files.push(format!("{id}.svg"));
+            files.push(format!("{id}.png"));
+        }
+        files
+    }
+}
+
+/// Removes every regular file of `dir` whose name is not in `keep` (files of an earlier run, or
+/// temporary files a killed run left behind), so that the folder holds exactly one run.
+fn prune(dir: &Path, keep: &[String]) -> Result<()> {
+    for entry in std::fs::read_dir(dir).map_err(io_err(dir))? {
+        let entry = entry.map_err(io_err(dir))?;
+        let path = entry.path();
+        let is_file = entry.file_type().map_err(io_err(&path))?.is_file();
+        let kept = keep
+            .iter()
+            .any(|k| entry.file_name().to_str() == Some(k.as_str()));
+        if is_file && !kept {
+            std::fs::remove_file(&path).map_err(io_err(&path))?;
+        }
+    }
+    Ok(())
+}
+
+fn json_err(path: &Path) -> impl FnOnce(serde_json::Error) -> ReproError + '_ {
+    move |e| ReproError::Csv {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    }
+}
+
+/// Reads the [`RunInfo`] of the run written in `dir` (its `run.json`).
+pub fn read_run_info(dir: &Path) -> Result<RunInfo> {
+    let path = dir.join("run.json");
+    let text = std::fs::read_to_string(&path).map_err(io_err(&path))?;
+    serde_json::from_str(&text).map_err(json_err(&path))
+}
+
+/// Replaces the run in `dest` with the run written in `fresh` (both a paper's folder): copies
+/// every file the fresh run wrote (as listed by its `run.json`), each atomically, then removes
+/// the files of `dest` the fresh run did not write. This is `--bless`.
+pub fn replace_run(fresh: &Path, dest: &Path) -> Result<()> {
+    let info = read_run_info(fresh)?;
+    let files = info.files();
+    std::fs::create_dir_all(dest).map_err(io_err(dest))?;
+    for name in &files {
+        let from = fresh.join(name);
+        let bytes = std::fs::read(&from).map_err(io_err(&from))?;
+        write_atomic(&dest.join(name), &bytes)?;
+    }
+    prune(dest, &files)
 }
 
 /// Writes one paper's results into `dir` (created if needed): `README.md` with every table,
 /// figure, claim and note; `<table>.md` and `<table>.csv` per table; `<figure>.svg` and
-/// `<figure>.png` per figure; `run.json` with the [`RunInfo`].
+/// `<figure>.png` per figure; `run.json` with the [`RunInfo`] (the list is
+/// [`RunInfo::files`]). Every file is written atomically ([`write_atomic`]); files of `dir`
+/// that this run did not write (an earlier run's) are removed afterwards.
 pub fn write_paper(result: &PaperResult, info: &RunInfo, dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(io_err(dir))?;
     let mut md = format!("# {}\n\n", info.title);
@@ -406,8 +523,8 @@ pub fn write_paper(result: &PaperResult, info: &RunInfo, dir: &Path) -> Result<(
     md.push_str("## Tables\n\n");
     for t in &result.tables {
         let table_md = t.to_markdown();
-        write(&dir.join(format!("{}.md", t.id)), &table_md)?;
-        write(&dir.join(format!("{}.csv", t.id)), &t.to_csv()?)?;
+        write_atomic(&dir.join(format!("{}.md", t.id)), table_md.as_bytes())?;
+        write_atomic(&dir.join(format!("{}.csv", t.id)), t.to_csv()?.as_bytes())?;
         md.push_str(&table_md);
         let _ = writeln!(md, "\n([CSV]({}.csv))\n", t.id);
     }
@@ -416,7 +533,9 @@ pub fn write_paper(result: &PaperResult, info: &RunInfo, dir: &Path) -> Result<(
     }
     for f in &result.figures {
         for ext in ["svg", "png"] {
-            write_chart(&f.chart, &dir.join(format!("{}.{ext}", f.id)))?;
+            write_atomic_with(&dir.join(format!("{}.{ext}", f.id)), |tmp| {
+                Ok(write_chart(&f.chart, tmp)?)
+            })?;
         }
         let _ = writeln!(
             md,
@@ -424,19 +543,19 @@ pub fn write_paper(result: &PaperResult, info: &RunInfo, dir: &Path) -> Result<(
             f.caption, f.id, f.caption, f.id
         );
     }
-    write(&dir.join("README.md"), &md)?;
-    let json = serde_json::to_string_pretty(info).map_err(|e| ReproError::Csv {
-        path: dir.join("run.json"),
-        reason: e.to_string(),
-    })?;
-    write(&dir.join("run.json"), &json)
+    write_atomic(&dir.join("README.md"), md.as_bytes())?;
+    let json_path = dir.join("run.json");
+    let json = serde_json::to_string_pretty(info).map_err(json_err(&json_path))?;
+    write_atomic(&json_path, json.as_bytes())?;
+    prune(dir, &info.files())
 }
 
 /// Rewrites `<root>/README.md`, the index over every paper's `run.json` found under `root`.
 pub fn write_index(root: &Path, explanations: &[(&str, &str)]) -> Result<()> {
     let mut md = String::from(
         "# Reproduced results\n\n\
-         Regenerated by `cargo xtask reproduce` (see the top-level README). Each paper's folder \
+         Written by `cargo xtask reproduce` (see the top-level README; the copy under \
+         `docs/results/` changes only with `--bless`). Each paper's folder \
          holds its tables (Markdown and CSV), figures (SVG and PNG) and a README with the run's \
          seed, revision, data and wall time. Claims are decided from the run's own numbers.\n\n",
     );
@@ -449,10 +568,7 @@ pub fn write_index(root: &Path, explanations: &[(&str, &str)]) -> Result<()> {
             );
             continue;
         };
-        let info: RunInfo = serde_json::from_str(&text).map_err(|e| ReproError::Csv {
-            path: path.clone(),
-            reason: e.to_string(),
-        })?;
+        let info: RunInfo = serde_json::from_str(&text).map_err(json_err(&path))?;
         let _ = writeln!(
             md,
             "## [{}]({slug}/README.md)\n\nRevision `{}`, seed {}, {:.1} s{}.\n",
@@ -487,97 +603,461 @@ pub fn write_index(root: &Path, explanations: &[(&str, &str)]) -> Result<()> {
         }
         let _ = writeln!(md, "{why}\n");
     }
-    write(&root.join("README.md"), &md)
+    write_atomic(&root.join("README.md"), md.as_bytes())
 }
 
-/// Compares the tables of a fresh run with the CSVs committed under `dir`. Returns the list of
-/// differences (empty when everything agrees within each column's tolerance).
-pub fn compare_with_committed(tables: &[Table], dir: &Path) -> Result<Vec<String>> {
-    let mut diffs = Vec::new();
-    for t in tables {
-        let path = dir.join(format!("{}.csv", t.id));
-        let text = match std::fs::read_to_string(&path) {
-            Ok(s) => s,
-            Err(_) => {
-                diffs.push(format!("{}: no committed file", path.display()));
-                continue;
+/// One way a fresh run differs from the committed one (`--check`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Difference {
+    /// There is no committed run to compare with: the folder, or its `run.json`, is missing.
+    NoCommittedRun {
+        /// The missing folder or file.
+        path: PathBuf,
+    },
+    /// A table is committed (`<table>.csv`) but the fresh run did not produce it.
+    MissingTable {
+        /// The table id.
+        table: String,
+    },
+    /// The fresh run produced a table that is not committed.
+    ExtraTable {
+        /// The table id.
+        table: String,
+    },
+    /// A table's columns differ (names or order).
+    Columns {
+        /// The table id.
+        table: String,
+        /// The committed headers.
+        committed: Vec<String>,
+        /// The fresh run's headers.
+        fresh: Vec<String>,
+    },
+    /// A committed row has no counterpart in the fresh run.
+    MissingRow {
+        /// The table id.
+        table: String,
+        /// The row: its labels (`m = 2`), or its position (`#3`) when the labels do not name
+        /// the rows uniquely.
+        row: String,
+    },
+    /// A row of the fresh run has no counterpart in the committed table.
+    ExtraRow {
+        /// The table id.
+        table: String,
+        /// The row, named as in [`Difference::MissingRow`].
+        row: String,
+    },
+    /// A cell differs by more than its column allows.
+    Cell {
+        /// The table id.
+        table: String,
+        /// The row, named as in [`Difference::MissingRow`].
+        row: String,
+        /// The column header.
+        column: String,
+        /// The committed cell, as in the CSV.
+        committed: String,
+        /// The fresh cell, as it would be written to the CSV.
+        fresh: String,
+        /// The largest difference the column allowed here (`abs + rel * max(|committed|,
+        /// |fresh|)`), for a column of our numbers whose cells are both finite numbers.
+        allowed: Option<f64>,
+    },
+    /// A figure is committed but the fresh run did not produce it.
+    MissingFigure {
+        /// The figure id.
+        figure: String,
+    },
+    /// The fresh run produced a figure that is not committed.
+    ExtraFigure {
+        /// The figure id.
+        figure: String,
+    },
+    /// A claim is committed but the fresh run did not check it.
+    MissingClaim {
+        /// The claim's statement.
+        statement: String,
+    },
+    /// The fresh run checked a claim that is not committed.
+    ExtraClaim {
+        /// The claim's statement.
+        statement: String,
+    },
+    /// A claim holds in one run and not in the other.
+    Verdict {
+        /// The claim's statement.
+        statement: String,
+        /// Whether it holds in the committed run.
+        committed: bool,
+        /// Whether it holds in the fresh run.
+        fresh: bool,
+    },
+}
+
+impl std::fmt::Display for Difference {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let yes_no = |b: bool| if b { "holds" } else { "does not hold" };
+        match self {
+            Difference::NoCommittedRun { path } => {
+                write!(
+                    f,
+                    "{}: missing, no committed run to compare with",
+                    path.display()
+                )
             }
-        };
-        let mut r = csv::Reader::from_reader(text.as_bytes());
-        let header: Vec<String> = r
-            .headers()
-            .map_err(|e| ReproError::Csv {
-                path: path.clone(),
-                reason: e.to_string(),
-            })?
-            .iter()
-            .map(str::to_string)
-            .collect();
-        let names: Vec<&str> = t.columns.iter().map(|c| c.name.as_str()).collect();
-        if header != names {
-            diffs.push(format!(
-                "{}: columns {:?}, fresh run has {:?}",
-                path.display(),
-                header,
-                names
-            ));
-            continue;
-        }
-        let mut committed_rows = 0;
-        for (i, rec) in r.records().enumerate() {
-            committed_rows += 1;
-            let rec = rec.map_err(|e| ReproError::Csv {
-                path: path.clone(),
-                reason: e.to_string(),
-            })?;
-            let Some(row) = t.rows.get(i) else { continue };
-            for ((cell, value), col) in rec.iter().zip(row).zip(&t.columns) {
-                if let Some(d) = compare_cell(cell, value, col) {
-                    diffs.push(format!(
-                        "{} row {} column \"{}\": {d}",
-                        path.display(),
-                        i + 1,
-                        col.name
-                    ));
+            Difference::MissingTable { table } => {
+                write!(f, "table {table}: committed, missing from the fresh run")
+            }
+            Difference::ExtraTable { table } => {
+                write!(f, "table {table}: in the fresh run, not committed")
+            }
+            Difference::Columns {
+                table,
+                committed,
+                fresh,
+            } => write!(
+                f,
+                "table {table}: committed columns {committed:?}, fresh run's {fresh:?}"
+            ),
+            Difference::MissingRow { table, row } => {
+                write!(
+                    f,
+                    "table {table}, row {row}: committed, missing from the fresh run"
+                )
+            }
+            Difference::ExtraRow { table, row } => {
+                write!(
+                    f,
+                    "table {table}, row {row}: in the fresh run, not committed"
+                )
+            }
+            Difference::Cell {
+                table,
+                row,
+                column,
+                committed,
+                fresh,
+                allowed,
+            } => {
+                write!(
+                    f,
+                    "table {table}, row {row}, column \"{column}\": committed {committed:?}, \
+                     fresh {fresh:?}"
+                )?;
+                match allowed {
+                    Some(a) => write!(f, " (allowed difference {a:e})"),
+                    None => write!(f, " (must be equal)"),
                 }
             }
+            Difference::MissingFigure { figure } => {
+                write!(f, "figure {figure}: committed, missing from the fresh run")
+            }
+            Difference::ExtraFigure { figure } => {
+                write!(f, "figure {figure}: in the fresh run, not committed")
+            }
+            Difference::MissingClaim { statement } => {
+                write!(
+                    f,
+                    "claim \"{statement}\": committed, missing from the fresh run"
+                )
+            }
+            Difference::ExtraClaim { statement } => {
+                write!(f, "claim \"{statement}\": in the fresh run, not committed")
+            }
+            Difference::Verdict {
+                statement,
+                committed,
+                fresh,
+            } => write!(
+                f,
+                "claim \"{statement}\": {} in the committed run, {} in the fresh run",
+                yes_no(*committed),
+                yes_no(*fresh)
+            ),
         }
-        if committed_rows != t.rows.len() {
-            diffs.push(format!(
-                "{}: {} committed rows, fresh run has {}",
-                path.display(),
-                committed_rows,
-                t.rows.len()
-            ));
+    }
+}
+
+/// A cell as it is written to (and read back from) the CSV.
+fn cell_text(v: &Value) -> String {
+    match v {
+        Value::Text(t) => t.clone(),
+        Value::Num(x) => format!("{x:?}"),
+        Value::Missing => String::new(),
+    }
+}
+
+/// Names rows by their label cells when those name every row uniquely on both sides, else by
+/// position.
+fn row_names(
+    committed: &[Vec<String>],
+    fresh: &[Vec<String>],
+    t: &Table,
+) -> (Vec<String>, Vec<String>) {
+    let labels: Vec<usize> = t
+        .columns
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.kind == ColumnKind::Label)
+        .map(|(i, _)| i)
+        .collect();
+    let by_label = |rows: &[Vec<String>]| -> Vec<String> {
+        rows.iter()
+            .map(|r| {
+                labels
+                    .iter()
+                    .map(|&i| {
+                        let value = r.get(i).map_or("", String::as_str);
+                        format!("{} = {value}", t.columns[i].name)
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            })
+            .collect()
+    };
+    let unique = |names: &[String]| {
+        let mut sorted: Vec<&String> = names.iter().collect();
+        sorted.sort();
+        sorted.windows(2).all(|w| w[0] != w[1])
+    };
+    let (c, f) = (by_label(committed), by_label(fresh));
+    if !labels.is_empty() && unique(&c) && unique(&f) {
+        (c, f)
+    } else {
+        let position = |n: usize| (1..=n).map(|i| format!("#{i}")).collect();
+        (position(committed.len()), position(fresh.len()))
+    }
+}
+
+/// Compares one fresh table with its committed CSV text.
+fn compare_table(t: &Table, path: &Path, text: &str, diffs: &mut Vec<Difference>) -> Result<()> {
+    let csv_err = |e: csv::Error| ReproError::Csv {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    };
+    let mut r = csv::Reader::from_reader(text.as_bytes());
+    let header: Vec<String> = r
+        .headers()
+        .map_err(csv_err)?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    let names: Vec<String> = t.columns.iter().map(|c| c.name.clone()).collect();
+    if header != names {
+        diffs.push(Difference::Columns {
+            table: t.id.clone(),
+            committed: header,
+            fresh: names,
+        });
+        return Ok(());
+    }
+    let committed: Vec<Vec<String>> = r
+        .records()
+        .map(|rec| rec.map(|rec| rec.iter().map(str::to_string).collect()))
+        .collect::<std::result::Result<_, _>>()
+        .map_err(csv_err)?;
+    let fresh: Vec<Vec<String>> = t
+        .rows
+        .iter()
+        .map(|row| row.iter().map(cell_text).collect())
+        .collect();
+    let (committed_names, fresh_names) = row_names(&committed, &fresh, t);
+    for (name, row) in committed_names.iter().zip(&committed) {
+        let Some(j) = fresh_names.iter().position(|n| n == name) else {
+            diffs.push(Difference::MissingRow {
+                table: t.id.clone(),
+                row: name.clone(),
+            });
+            continue;
+        };
+        for ((cell, value), col) in row.iter().zip(&t.rows[j]).zip(&t.columns) {
+            if let Some((fresh, allowed)) = compare_cell(cell, value, col) {
+                diffs.push(Difference::Cell {
+                    table: t.id.clone(),
+                    row: name.clone(),
+                    column: col.name.clone(),
+                    committed: cell.clone(),
+                    fresh,
+                    allowed,
+                });
+            }
+        }
+    }
+    for name in &fresh_names {
+        if !committed_names.contains(name) {
+            diffs.push(Difference::ExtraRow {
+                table: t.id.clone(),
+                row: name.clone(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Compares the tables of a fresh run with the CSVs committed in `dir` (a paper's folder) and
+/// returns every difference, in the order: per fresh table, its columns, rows and cells (or
+/// [`Difference::ExtraTable`]); then the committed tables the fresh run lacks
+/// ([`Difference::MissingTable`], every `<id>.csv` of `dir` counts as a committed table).
+///
+/// Rows are matched by their label cells when those name each row uniquely (else by
+/// position); a committed row without a fresh counterpart is [`Difference::MissingRow`], and
+/// the other way round [`Difference::ExtraRow`]. Cells are compared by their column's
+/// [`ColumnKind`]:
+///
+/// - [`ColumnKind::Label`] and [`ColumnKind::Paper`]: equal (as text, or as numbers);
+/// - [`ColumnKind::Ours`] `{ abs, rel }`: equal text, or both finite numbers with
+///   `|committed - fresh| <= abs + rel * max(|committed|, |fresh|)` — the relative part scales
+///   with the two values compared, and is the same whichever side is taken as the reference;
+///   two NaNs or two equal infinities agree, a number never agrees with an empty (missing)
+///   cell, and a non-finite value never agrees with a finite one;
+/// - [`ColumnKind::Timing`]: not compared.
+///
+/// A missing `dir` is one [`Difference::NoCommittedRun`].
+pub fn compare_with_committed(tables: &[Table], dir: &Path) -> Result<Vec<Difference>> {
+    let entries = match std::fs::read_dir(dir) {
+        Ok(e) => e,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Ok(vec![Difference::NoCommittedRun {
+                path: dir.to_path_buf(),
+            }]);
+        }
+        Err(e) => {
+            return Err(ReproError::Io {
+                path: dir.to_path_buf(),
+                source: e,
+            });
+        }
+    };
+    let mut committed_ids = Vec::new();
+    for entry in entries {
+        let path = entry.map_err(io_err(dir))?.path();
+        let hidden = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .is_none_or(|n| n.starts_with('.'));
+        if !hidden
+            && path.extension().is_some_and(|e| e == "csv")
+            && path.is_file()
+            && let Some(stem) = path.file_stem().and_then(|s| s.to_str())
+        {
+            committed_ids.push(stem.to_string());
+        }
+    }
+    committed_ids.sort();
+    let mut diffs = Vec::new();
+    for t in tables {
+        if !committed_ids.contains(&t.id) {
+            diffs.push(Difference::ExtraTable {
+                table: t.id.clone(),
+            });
+            continue;
+        }
+        let path = dir.join(format!("{}.csv", t.id));
+        let text = std::fs::read_to_string(&path).map_err(io_err(&path))?;
+        compare_table(t, &path, &text, &mut diffs)?;
+    }
+    for id in committed_ids {
+        if !tables.iter().any(|t| t.id == id) {
+            diffs.push(Difference::MissingTable { table: id });
         }
     }
     Ok(diffs)
 }
 
-fn compare_cell(committed: &str, fresh: &Value, col: &Column) -> Option<String> {
-    let fresh_text = match fresh {
-        Value::Text(t) => t.clone(),
-        Value::Num(x) => format!("{x:?}"),
-        Value::Missing => String::new(),
-    };
-    match col.kind {
-        ColumnKind::Timing => None,
-        ColumnKind::Label | ColumnKind::Paper => {
-            let same = match (committed.parse::<f64>(), fresh) {
-                (Ok(a), Value::Num(b)) => a == *b,
-                _ => committed == fresh_text,
-            };
-            (!same).then(|| format!("committed {committed:?}, fresh {fresh_text:?}"))
+/// Compares a whole fresh run with the run committed in `dir` (a paper's folder): its tables
+/// as [`compare_with_committed`] does, then its figures and claims against the committed
+/// `run.json` (a figure or claim on one side only is a difference, and so is a claim that
+/// holds in one run and not in the other; claims are matched by statement, their evidence is
+/// not compared). Titles, notes and wall times are not compared.
+pub fn compare_run(result: &PaperResult, dir: &Path) -> Result<Vec<Difference>> {
+    let mut diffs = compare_with_committed(&result.tables, dir)?;
+    if matches!(diffs.as_slice(), [Difference::NoCommittedRun { .. }]) {
+        return Ok(diffs);
+    }
+    let json = dir.join("run.json");
+    if !json.is_file() {
+        diffs.push(Difference::NoCommittedRun { path: json });
+        return Ok(diffs);
+    }
+    let info = read_run_info(dir)?;
+    for (id, _) in &info.figures {
+        if !result.figures.iter().any(|f| &f.id == id) {
+            diffs.push(Difference::MissingFigure { figure: id.clone() });
         }
-        ColumnKind::Ours { abs, rel } => match (committed.parse::<f64>(), fresh) {
-            (Ok(a), Value::Num(b)) => {
-                let ok = (a - b).abs() <= abs + rel * a.abs() || (a.is_nan() && b.is_nan());
-                (!ok).then(|| {
-                    format!("committed {a}, fresh {b} (tolerance {abs} + {rel} x |committed|)")
-                })
+    }
+    for f in &result.figures {
+        if !info.figures.iter().any(|(id, _)| id == &f.id) {
+            diffs.push(Difference::ExtraFigure {
+                figure: f.id.clone(),
+            });
+        }
+    }
+    // claims are matched by statement, each fresh claim at most once
+    let mut unmatched: Vec<&Claim> = result.claims.iter().collect();
+    for c in &info.claims {
+        match unmatched.iter().position(|f| f.statement == c.statement) {
+            Some(i) => {
+                let f = unmatched.remove(i);
+                if f.holds != c.holds {
+                    diffs.push(Difference::Verdict {
+                        statement: c.statement.clone(),
+                        committed: c.holds,
+                        fresh: f.holds,
+                    });
+                }
             }
-            _ if committed.is_empty() && *fresh == Value::Missing => None,
-            _ => Some(format!("committed {committed:?}, fresh {fresh_text:?}")),
-        },
+            None => diffs.push(Difference::MissingClaim {
+                statement: c.statement.clone(),
+            }),
+        }
+    }
+    for f in unmatched {
+        diffs.push(Difference::ExtraClaim {
+            statement: f.statement.clone(),
+        });
+    }
+    Ok(diffs)
+}
+
+/// `--check` of one paper: compares `result` with the run committed in `dir` ([`compare_run`])
+/// and fails with [`ReproError::CheckFailed`], listing every difference, unless they agree.
+pub fn check_run(paper: &str, result: &PaperResult, dir: &Path) -> Result<()> {
+    let differences = compare_run(result, dir)?;
+    if differences.is_empty() {
+        Ok(())
+    } else {
+        Err(ReproError::CheckFailed {
+            paper: paper.to_string(),
+            committed: dir.to_path_buf(),
+            differences,
+        })
+    }
+}
+
+/// Whether a committed cell and a fresh one agree under `col`'s kind (see
+/// [`compare_with_committed`]); when they do not, the fresh cell's text and the allowed
+/// difference (for a column of ours with two finite numbers).
+fn compare_cell(committed: &str, fresh: &Value, col: &Column) -> Option<(String, Option<f64>)> {
+    let fresh_text = cell_text(fresh);
+    if col.kind == ColumnKind::Timing || committed == fresh_text {
+        return None;
+    }
+    let numbers = match (committed.parse::<f64>(), fresh) {
+        (Ok(a), Value::Num(b)) => Some((a, *b)),
+        _ => None,
+    };
+    let Some((a, b)) = numbers else {
+        return Some((fresh_text, None));
+    };
+    if a == b || (a.is_nan() && b.is_nan()) {
+        return None;
+    }
+    match col.kind {
+        ColumnKind::Ours { abs, rel } if a.is_finite() && b.is_finite() => {
+            let allowed = abs + rel * a.abs().max(b.abs());
+            ((a - b).abs() > allowed).then_some((fresh_text, Some(allowed)))
+        }
+        _ => Some((fresh_text, None)),
     }
 }
