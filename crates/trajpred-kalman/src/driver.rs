@@ -127,6 +127,7 @@ where
     make: Make,
     state: Gaussian<T, D>,
     built: Option<(T, F)>,
+    log_likelihood: T,
 }
 
 impl<T, D, F, Make> Timed<T, D, F, Make>
@@ -141,7 +142,14 @@ where
             make,
             state,
             built: None,
+            log_likelihood: T::zero(),
         }
+    }
+
+    /// The total log-likelihood `sum_k ln N(y_k; 0, S_k)` of the observations this filter
+    /// has been updated with (what a maximum-likelihood fit of the noise maximises).
+    pub fn log_likelihood(&self) -> T {
+        self.log_likelihood
     }
 
     /// The current estimate, by reference.
@@ -174,7 +182,9 @@ where
         };
         let result = filter.step(&self.state, z);
         self.built = Some((dt, filter));
-        self.state = result?.posterior().clone();
+        let step = result?;
+        self.log_likelihood += step.log_likelihood();
+        self.state = step.posterior().clone();
         Ok(())
     }
 

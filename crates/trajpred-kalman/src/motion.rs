@@ -130,6 +130,76 @@ where
 {
     check_positive("dt", dt, false)?;
     check_positive("var", var, true)?;
+    kinematic_with(layout, dt, white_noise_block(layout.derivatives, dt, var))
+}
+
+/// The continuous white-noise block for one axis (filterpy's
+/// `Q_continuous_white_noise(dim, dt, spectral_density)`, dim 2 or 3): the exact covariance
+/// of a white noise of density `q` on the highest derivative integrated over `dt`.
+fn continuous_noise_block(derivatives: usize, dt: f64, q: f64) -> [[f64; 3]; 3] {
+    let t = |p: i32| dt.powi(p) * q;
+    if derivatives == 2 {
+        [
+            [t(3) / 3.0, t(2) / 2.0, 0.0],
+            [t(2) / 2.0, t(1), 0.0],
+            [0.0; 3],
+        ]
+    } else {
+        [
+            [t(5) / 20.0, t(4) / 8.0, t(3) / 6.0],
+            [t(4) / 8.0, t(3) / 3.0, t(2) / 2.0],
+            [t(3) / 6.0, t(2) / 2.0, t(1)],
+        ]
+    }
+}
+
+/// The kinematic transition of `layout` for the time step `dt`, with the process noise of a
+/// continuous white noise of spectral density `spectral_density` on the highest derivative
+/// (acceleration for constant velocity, jerk for constant acceleration), per axis
+/// (filterpy's `Q_continuous_white_noise`). Unlike the discrete model of [`kinematic`], two
+/// steps of `dt / 2` give the same prediction as one step of `dt`, so a track sampled at
+/// irregular times gets the noise its intervals call for.
+///
+/// ```
+/// use nalgebra::U2;
+/// use trajpred_kalman::motion::{KinematicLayout, StateOrder, kinematic_continuous};
+/// use trajpred_kalman::{LinearTransitionModel, Transition};
+/// let cv = kinematic_continuous::<f64, U2>(KinematicLayout::new(1, 2, StateOrder::PositionsFirst)?, 2.0, 3.0)?;
+/// // q [[dt^3/3, dt^2/2], [dt^2/2, dt]] with q = 3, dt = 2
+/// assert_eq!(cv.process_noise()[(0, 0)], 8.0);
+/// assert_eq!(cv.process_noise()[(0, 1)], 6.0);
+/// assert_eq!(cv.process_noise()[(1, 1)], 6.0);
+/// # Ok::<(), trajpred_kalman::KalmanError>(())
+/// ```
+pub fn kinematic_continuous<T, D>(
+    layout: KinematicLayout,
+    dt: f64,
+    spectral_density: f64,
+) -> Result<LinearTransition<T, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    check_positive("dt", dt, false)?;
+    check_positive("spectral_density", spectral_density, true)?;
+    kinematic_with(
+        layout,
+        dt,
+        continuous_noise_block(layout.derivatives, dt, spectral_density),
+    )
+}
+
+fn kinematic_with<T, D>(
+    layout: KinematicLayout,
+    dt: f64,
+    q_block: [[f64; 3]; 3],
+) -> Result<LinearTransition<T, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
     let n = layout.state_dim();
     let d: D = state_dim_type(n)?;
     let k = layout.derivatives;
@@ -142,7 +212,6 @@ where
             dt.powi(p) / if p == 2 { 2.0 } else { 1.0 }
         }
     };
-    let q_block = white_noise_block(k, dt, var);
     let mut f = OMatrix::<T, D, D>::zeros_generic(d, d);
     let mut q = OMatrix::<T, D, D>::zeros_generic(d, d);
     for axis in 0..layout.axes {
