@@ -27,5 +27,7 @@ pub mod window;
 
 pub use error::{Error, Result};
 pub use gaussian::Gaussian;
-pub use predictor::{Forecast, Predictor, check_forecast_args};
+pub use predictor::{
+    Forecast, MAX_HORIZON, Predictor, check_forecast_args, check_forecast_args_with_max,
+};
 pub use trajectory::{MAX_AXES, Point, Trajectory};

@@ -136,7 +136,7 @@ impl Forecast {
 /// The trait is object safe, so a method chosen at run time is a `Box<dyn Predictor>`:
 ///
 /// ```
-/// use trajpred_core::{Forecast, Predictor, Result, Trajectory};
+/// use trajpred_core::{check_forecast_args, Forecast, Predictor, Result, Trajectory};
 ///
 /// /// Repeats the last point.
 /// struct Persistence;
@@ -144,6 +144,7 @@ impl Forecast {
 ///     fn name(&self) -> &str { "persistence" }
 ///     fn fit(&mut self, _train: &[Trajectory]) -> Result<()> { Ok(()) }
 ///     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
+///         check_forecast_args(history, horizon, self.min_history())?;
 ///         let last = history.last_point();
 ///         Forecast::new(history.dim(), vec![last; horizon])
 ///     }
@@ -195,13 +196,51 @@ impl<P: Predictor + ?Sized> Predictor for Box<P> {
     }
 }
 
-/// Checks the arguments every `forecast` must check: `horizon >= 1` and a long enough
-/// history. Implementations call it first.
+/// The longest forecast [`check_forecast_args`] accepts, in steps.
+///
+/// A forecast holds `horizon` points (and perhaps `horizon` covariances), so an unchecked
+/// horizon read from a command line (`--horizon 100000000000`) would make a predictor try to
+/// allocate terabytes and abort. 100 000 steps is 27 hours at one point a second, far beyond
+/// any horizon a trajectory model is meaningful for; a predictor that needs more calls
+/// [`check_forecast_args_with_max`] with its own limit.
+pub const MAX_HORIZON: usize = 100_000;
+
+/// Checks the arguments every `forecast` must check: `1 <= horizon <= MAX_HORIZON` and a long
+/// enough history. Implementations call it first, before allocating anything that grows with
+/// the horizon.
+///
+/// ```
+/// use trajpred_core::{check_forecast_args, Error, Trajectory, MAX_HORIZON};
+/// let tr = Trajectory::uniform(0.0, 1.0, vec![vec![1.0, 2.0]])?;
+/// assert!(check_forecast_args(&tr, MAX_HORIZON, 1).is_ok());
+/// assert!(matches!(
+///     check_forecast_args(&tr, MAX_HORIZON + 1, 1),
+///     Err(Error::InvalidParameter { name: "horizon", .. })
+/// ));
+/// # Ok::<(), trajpred_core::Error>(())
+/// ```
 pub fn check_forecast_args(history: &Trajectory, horizon: usize, min_history: usize) -> Result<()> {
+    check_forecast_args_with_max(history, horizon, min_history, MAX_HORIZON)
+}
+
+/// [`check_forecast_args`] with a horizon limit of the caller's choosing (`max_horizon`
+/// instead of [`MAX_HORIZON`]).
+pub fn check_forecast_args_with_max(
+    history: &Trajectory,
+    horizon: usize,
+    min_history: usize,
+    max_horizon: usize,
+) -> Result<()> {
     if horizon == 0 {
         return Err(Error::InvalidParameter {
             name: "horizon",
             reason: "must be at least 1".into(),
+        });
+    }
+    if horizon > max_horizon {
+        return Err(Error::InvalidParameter {
+            name: "horizon",
+            reason: format!("{horizon} steps exceeds the maximum horizon of {max_horizon} steps"),
         });
     }
     if history.len() < min_history {

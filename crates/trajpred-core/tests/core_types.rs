@@ -348,3 +348,33 @@ fn gaussian_rejects_bad_covariances() {
         Err(Error::NotPositiveDefinite { .. })
     ));
 }
+
+/// A horizon above `MAX_HORIZON` is refused before the predictor allocates anything: asking
+/// for 10^11 steps used to abort on a 7.2 TB allocation.
+#[test]
+fn horizon_above_the_maximum_is_an_error_naming_the_limit() {
+    let tr = Trajectory::uniform(0.0, 1.0, vec![vec![1.0, 2.0, 3.0]]).unwrap();
+    let p: Box<dyn Predictor> = Box::new(LastValue);
+    assert_eq!(p.forecast(&tr, MAX_HORIZON).unwrap().horizon(), MAX_HORIZON);
+    for horizon in [MAX_HORIZON + 1, 100_000_000_000, usize::MAX] {
+        match p.forecast(&tr, horizon) {
+            Err(Error::InvalidParameter {
+                name: "horizon",
+                reason,
+            }) => assert!(
+                reason.contains(&MAX_HORIZON.to_string()),
+                "reason should name the limit: {reason}"
+            ),
+            other => panic!("horizon {horizon}: expected InvalidParameter, got {other:?}"),
+        }
+    }
+    // a caller's own limit
+    assert!(check_forecast_args_with_max(&tr, 10, 1, 10).is_ok());
+    assert!(matches!(
+        check_forecast_args_with_max(&tr, 11, 1, 10),
+        Err(Error::InvalidParameter {
+            name: "horizon",
+            ..
+        })
+    ));
+}

@@ -25,7 +25,10 @@ use crate::geodesy::FOOT;
 use crate::io::{list, read_all};
 use crate::report::{LoadReport, SkipReason};
 use crate::track::{Cleaner, FrameKind, LoadOptions, RawPoint, Track};
-use serde::de::{self, Deserialize, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
+use serde::de::{
+    self, Deserialize, DeserializeSeed, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor,
+};
+use std::cell::Cell;
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
@@ -237,11 +240,62 @@ struct Columns {
     flight_id: Vec<(usize, Text)>,
 }
 
-/// One column: `{"<row>": value, ...}`; a row key that is not an index fails the document.
-struct Column<T>(Vec<(usize, T)>);
+/// The most records (rows of a column) a document may hold, and whether it crossed that.
+#[derive(Clone, Copy)]
+struct RowCap<'a> {
+    max: usize,
+    hit: &'a Cell<bool>,
+}
 
-impl<'de, T: Deserialize<'de>> Deserialize<'de> for Column<T> {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+impl RowCap<'_> {
+    /// An error (and `hit` set) once `len` rows are held and one more arrives.
+    fn check<E: de::Error>(&self, len: usize) -> Result<(), E> {
+        if len >= self.max {
+            self.hit.set(true);
+            return Err(E::custom(format!("more than {} records", self.max)));
+        }
+        Ok(())
+    }
+}
+
+/// The list layout: `[record, ...]`, at most `cap.max` records.
+struct RecordList<'a>(RowCap<'a>);
+
+impl<'de> DeserializeSeed<'de> for RecordList<'_> {
+    type Value = Vec<Record>;
+    fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<Vec<Record>, D::Error> {
+        struct V<'a>(RowCap<'a>);
+        impl<'de> Visitor<'de> for V<'_> {
+            type Value = Vec<Record>;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an array of records")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut a: A) -> Result<Vec<Record>, A::Error> {
+                let mut out = Vec::new();
+                while let Some(r) = a.next_element::<Record>()? {
+                    self.0.check::<A::Error>(out.len())?;
+                    out.push(r);
+                }
+                Ok(out)
+            }
+        }
+        d.deserialize_seq(V(self.0))
+    }
+}
+
+/// One column: `{"<row>": value, ...}`, at most `cap.max` rows; a row key that is not an
+/// index fails the document.
+struct Column<'a, T>(RowCap<'a>, std::marker::PhantomData<T>);
+
+impl<'a, T> Column<'a, T> {
+    fn new(cap: RowCap<'a>) -> Self {
+        Column(cap, std::marker::PhantomData)
+    }
+}
+
+impl<'de, T: Deserialize<'de>> DeserializeSeed<'de> for Column<'_, T> {
+    type Value = Vec<(usize, T)>;
+    fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
         struct RowKey(usize);
         impl<'de> Deserialize<'de> for RowKey {
             fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
@@ -260,43 +314,49 @@ impl<'de, T: Deserialize<'de>> Deserialize<'de> for Column<T> {
                 d.deserialize_str(V)
             }
         }
-        struct V<T>(std::marker::PhantomData<T>);
-        impl<'de, T: Deserialize<'de>> Visitor<'de> for V<T> {
-            type Value = Column<T>;
+        struct V<'a, T>(RowCap<'a>, std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de>> Visitor<'de> for V<'_, T> {
+            type Value = Vec<(usize, T)>;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
                 f.write_str("an object of rows")
             }
-            fn visit_map<A: MapAccess<'de>>(self, mut a: A) -> Result<Column<T>, A::Error> {
+            fn visit_map<A: MapAccess<'de>>(self, mut a: A) -> Result<Self::Value, A::Error> {
                 let mut out = Vec::new();
                 while let Some((k, v)) = a.next_entry::<RowKey, T>()? {
+                    self.0.check::<A::Error>(out.len())?;
                     out.push((k.0, v));
                 }
-                Ok(Column(out))
+                Ok(out)
             }
         }
-        d.deserialize_map(V(std::marker::PhantomData))
+        d.deserialize_map(V(self.0, std::marker::PhantomData))
     }
 }
 
-impl<'de> Deserialize<'de> for Columns {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct V;
-        impl<'de> Visitor<'de> for V {
+/// pandas' column-wise layout, each column of at most `cap.max` rows.
+struct ColumnsSeed<'a>(RowCap<'a>);
+
+impl<'de> DeserializeSeed<'de> for ColumnsSeed<'_> {
+    type Value = Columns;
+    fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<Columns, D::Error> {
+        struct V<'a>(RowCap<'a>);
+        impl<'de> Visitor<'de> for V<'_> {
             type Value = Columns;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
                 f.write_str("an object of columns")
             }
             fn visit_map<A: MapAccess<'de>>(self, mut a: A) -> Result<Columns, A::Error> {
+                let cap = self.0;
                 let mut c = Columns::default();
                 while let Some(k) = a.next_key::<Key>()? {
                     match k {
-                        Key::Timestamp => c.timestamp = a.next_value::<Column<Num>>()?.0,
-                        Key::Latitude => c.latitude = a.next_value::<Column<Num>>()?.0,
-                        Key::Longitude => c.longitude = a.next_value::<Column<Num>>()?.0,
-                        Key::Altitude => c.altitude = a.next_value::<Column<Num>>()?.0,
-                        Key::Icao24 => c.icao24 = a.next_value::<Column<Text>>()?.0,
-                        Key::Callsign => c.callsign = a.next_value::<Column<Text>>()?.0,
-                        Key::FlightId => c.flight_id = a.next_value::<Column<Text>>()?.0,
+                        Key::Timestamp => c.timestamp = a.next_value_seed(Column::new(cap))?,
+                        Key::Latitude => c.latitude = a.next_value_seed(Column::new(cap))?,
+                        Key::Longitude => c.longitude = a.next_value_seed(Column::new(cap))?,
+                        Key::Altitude => c.altitude = a.next_value_seed(Column::new(cap))?,
+                        Key::Icao24 => c.icao24 = a.next_value_seed(Column::new(cap))?,
+                        Key::Callsign => c.callsign = a.next_value_seed(Column::new(cap))?,
+                        Key::FlightId => c.flight_id = a.next_value_seed(Column::new(cap))?,
                         Key::Other => {
                             a.next_value::<IgnoredAny>()?;
                         }
@@ -305,8 +365,19 @@ impl<'de> Deserialize<'de> for Columns {
                 Ok(c)
             }
         }
-        d.deserialize_map(V)
+        d.deserialize_map(V(self.0))
     }
+}
+
+/// Deserializes the whole of `json` with `seed`, then checks nothing but whitespace follows.
+fn from_slice_seed<'de, S: DeserializeSeed<'de>>(
+    json: &'de [u8],
+    seed: S,
+) -> serde_json::Result<S::Value> {
+    let mut de = serde_json::Deserializer::from_slice(json);
+    let v = seed.deserialize(&mut de)?;
+    de.end()?;
+    Ok(v)
 }
 
 /// Parses one JSON document (already decompressed) named `file`, adding to `report`.
@@ -320,13 +391,30 @@ pub fn parse_json(
 ) -> Result<Vec<Track>> {
     opts.validate()?;
     report.files_read += 1;
-    let mut c = Cleaner { opts, file, report };
-    let json_err = |e: serde_json::Error| Error::parse(file, e.line(), format!("JSON: {e}"));
+    // every record is held until the document is parsed: they count towards the points
+    let hit = Cell::new(false);
+    let cap = RowCap {
+        max: opts.max_total_points.saturating_sub(report.points_kept),
+        hit: &hit,
+    };
+    let mut c = Cleaner::new(opts, file, report);
+    let json_err = |e: serde_json::Error| {
+        if hit.get() {
+            return Error::LimitExceeded {
+                file: file.to_string(),
+                line: None,
+                option: "max_total_points",
+                limit: opts.max_total_points as u64,
+                what: "records (points) in one load",
+            };
+        }
+        Error::parse(file, e.line(), format!("JSON: {e}"))
+    };
     let first = json.iter().find(|b| !b.is_ascii_whitespace());
     let mut records: Vec<(usize, Record)> = Vec::new();
     match first {
         Some(b'[') => {
-            let all: Vec<Record> = serde_json::from_slice(json).map_err(json_err)?;
+            let all: Vec<Record> = from_slice_seed(json, RecordList(cap)).map_err(json_err)?;
             records.reserve(all.len());
             for (i, mut r) in all.into_iter().enumerate() {
                 c.report.records_read += 1;
@@ -337,7 +425,7 @@ pub fn parse_json(
             }
         }
         Some(b'{') => {
-            let cols: Columns = serde_json::from_slice(json).map_err(json_err)?;
+            let cols: Columns = from_slice_seed(json, ColumnsSeed(cap)).map_err(json_err)?;
             let mut rows: BTreeMap<usize, Record> = BTreeMap::new();
             macro_rules! fill {
                 ($col:expr, $field:ident, $name:literal) => {
@@ -408,6 +496,7 @@ pub fn parse_json(
             alt: r.altitude.map(|ft| ft * FOOT),
         };
         if c.accept_geodetic(&p)? {
+            c.hold(line, group.len())?;
             group.push(p);
         }
     }
@@ -432,9 +521,12 @@ pub fn parse_json(
     Ok(out)
 }
 
-/// Loads one `.json` or `.json.gz` file (gzip detected by its magic bytes).
+/// Loads one `.json` or `.json.gz` file (gzip detected by its magic bytes). The document is
+/// read whole, at most [`LoadOptions::max_json_bytes`] of it (decompressed): a larger one is
+/// an [`Error::LimitExceeded`].
 pub fn load_file(path: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadReport)> {
-    let bytes = read_all(path)?;
+    opts.validate()?;
+    let bytes = read_all(path, opts.max_json_bytes, "max_json_bytes")?;
     let mut report = LoadReport::new();
     let tracks = parse_json(&bytes, &path.display().to_string(), opts, &mut report)?;
     Ok((tracks, report))
@@ -460,14 +552,20 @@ pub fn files(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(out)
 }
 
-/// Loads every file of [`files`]`(dir)`.
+/// Loads every file of [`files`]`(dir)`; [`LoadOptions::max_total_points`] bounds the
+/// records of them all.
 pub fn load_dir(dir: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadReport)> {
+    opts.validate()?;
     let mut tracks = Vec::new();
     let mut report = LoadReport::new();
     for f in files(dir)? {
-        let (t, r) = load_file(&f, opts)?;
-        tracks.extend(t);
-        report.merge(r);
+        let bytes = read_all(&f, opts.max_json_bytes, "max_json_bytes")?;
+        tracks.extend(parse_json(
+            &bytes,
+            &f.display().to_string(),
+            opts,
+            &mut report,
+        )?);
     }
     Ok((tracks, report))
 }

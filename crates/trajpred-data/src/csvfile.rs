@@ -56,7 +56,7 @@
 //! # Ok::<(), trajpred_data::Error>(())
 //! ```
 
-use crate::error::{Error, Result};
+use crate::error::{Error, LimitHit, Result};
 use crate::io::{list, open, stem};
 use crate::report::{LoadReport, SkipReason};
 use crate::time::{TimeUnit, parse_iso8601};
@@ -151,7 +151,8 @@ fn coordinate(s: &str) -> Option<f64> {
 }
 
 /// A reader that remembers where the line ends are, so a record's line number counts the
-/// empty lines the CSV parser skips (its own positions do not).
+/// empty lines the CSV parser skips (its own positions do not), and that enforces
+/// [`LoadOptions::max_line_bytes`] and [`LoadOptions::max_file_bytes`] on the bytes it passes.
 struct LineTracker<R> {
     inner: R,
     /// Bytes read so far.
@@ -163,15 +164,42 @@ struct LineTracker<R> {
     /// `\n` bytes read in all, and the last byte read.
     newlines_total: usize,
     last_byte: Option<u8>,
+    /// Bytes of the current line so far (line ends excluded), and the limits.
+    line_len: usize,
+    max_line: usize,
+    max_bytes: u64,
 }
 
 impl<R: Read> Read for LineTracker<R> {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
         let n = self.inner.read(buf)?;
+        if self.offset.saturating_add(n as u64) > self.max_bytes {
+            return Err(LimitHit {
+                line: Some(self.newlines_total + 1),
+                option: "max_file_bytes",
+                limit: self.max_bytes,
+                what: "decompressed size in bytes",
+            }
+            .into_io());
+        }
         for (i, &b) in buf.iter().take(n).enumerate() {
             if b == b'\n' || b == b'\r' {
                 self.ends.push_back((self.offset + i as u64, b));
-                self.newlines_total += usize::from(b == b'\n');
+                if b == b'\n' {
+                    self.newlines_total += 1;
+                    self.line_len = 0;
+                }
+            } else {
+                self.line_len += 1;
+                if self.line_len > self.max_line {
+                    return Err(LimitHit {
+                        line: Some(self.newlines_total + 1),
+                        option: "max_line_bytes",
+                        limit: self.max_line as u64,
+                        what: "line length in bytes",
+                    }
+                    .into_io());
+                }
             }
         }
         if n > 0 {
@@ -183,7 +211,7 @@ impl<R: Read> Read for LineTracker<R> {
 }
 
 impl<R> LineTracker<R> {
-    fn new(inner: R) -> Self {
+    fn new(inner: R, opts: &LoadOptions) -> Self {
         LineTracker {
             inner,
             offset: 0,
@@ -191,6 +219,9 @@ impl<R> LineTracker<R> {
             newlines_passed: 0,
             newlines_total: 0,
             last_byte: None,
+            line_len: 0,
+            max_line: opts.max_line_bytes,
+            max_bytes: opts.max_file_bytes,
         }
     }
 
@@ -238,7 +269,7 @@ pub fn parse<R: Read>(
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
-        .from_reader(LineTracker::new(reader));
+        .from_reader(LineTracker::new(reader, opts));
     // the last line of the previous record, to count the empty lines between records
     let mut previous_end = 0usize;
     let mut rec = csv::ByteRecord::new();
@@ -248,7 +279,7 @@ pub fn parse<R: Read>(
     // the points of each track value, in order of first appearance
     let mut groups: Vec<(String, Vec<RawPoint>)> = Vec::new();
     let mut index: HashMap<String, usize> = HashMap::new();
-    let mut c = Cleaner { opts, file, report };
+    let mut c = Cleaner::new(opts, file, report);
     loop {
         let more = match rdr.read_byte_record(&mut rec) {
             Ok(m) => m,
@@ -363,6 +394,7 @@ pub fn parse<R: Read>(
                 groups.push((String::new(), Vec::new()));
             }
             if let Some((_, points)) = groups.get_mut(slot) {
+                c.hold(line, points.len())?;
                 points.push(p);
             }
         }
@@ -412,8 +444,8 @@ pub fn files(dir: &Path) -> Result<Vec<PathBuf>> {
 }
 
 /// Loads a CSV file, or every file of [`files`]`(path)` when `path` is a folder, one after
-/// the other (the report adds them up). A folder without a CSV file is an [`Error::Layout`]
-/// naming it.
+/// the other (the report adds them up; [`LoadOptions::max_total_points`] bounds the points
+/// of them all). A folder without a CSV file is an [`Error::Layout`] naming it.
 pub fn load_path(path: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadReport)> {
     if !path.is_dir() {
         return load_file(path, opts);
@@ -428,9 +460,12 @@ pub fn load_path(path: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadRep
     let mut tracks = Vec::new();
     let mut report = LoadReport::new();
     for f in found {
-        let (t, r) = load_file(&f, opts)?;
-        tracks.extend(t);
-        report.merge(r);
+        tracks.extend(parse(
+            open(&f)?,
+            &f.display().to_string(),
+            opts,
+            &mut report,
+        )?);
     }
     Ok((tracks, report))
 }

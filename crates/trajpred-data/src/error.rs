@@ -45,6 +45,24 @@ pub enum Error {
         /// What was expected.
         reason: String,
     },
+    /// Input crossed one of the limits of [`LoadOptions`](crate::LoadOptions) (a line, a
+    /// file's decompressed size, the points of one track or of one load). Raise the named
+    /// field to read it anyway.
+    #[error("{file}{}: {what} exceeds the limit of {limit} (LoadOptions::{option})", .line.map(|l| format!(":{l}")).unwrap_or_default())]
+    LimitExceeded {
+        /// The file (or the name given to in-memory input).
+        file: String,
+        /// The 1-based line (for JSON: record) where the limit was crossed, where known.
+        line: Option<usize>,
+        /// The [`LoadOptions`](crate::LoadOptions) field that sets the limit
+        /// (`max_line_bytes`, `max_file_bytes`, `max_json_bytes`, `max_track_points`,
+        /// `max_total_points`).
+        option: &'static str,
+        /// The limit's value.
+        limit: u64,
+        /// What crossed it, in words ("line length in bytes", ...).
+        what: &'static str,
+    },
     /// A trajectory could not be built (see [`trajpred_core::Error`]).
     #[error(transparent)]
     Trajectory(#[from] trajpred_core::Error),
@@ -54,7 +72,12 @@ pub enum Error {
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 impl Error {
+    /// An I/O error of `file`; a [`LimitHit`] carried by a reader (the CSV loader's) becomes
+    /// [`Error::LimitExceeded`].
     pub(crate) fn io(file: impl std::fmt::Display, source: std::io::Error) -> Self {
+        if let Some(hit) = source.get_ref().and_then(|e| e.downcast_ref::<LimitHit>()) {
+            return hit.to_error(file);
+        }
         Error::Io {
             file: file.to_string(),
             source,
@@ -76,3 +99,40 @@ impl Error {
         }
     }
 }
+
+/// A limit crossed inside a reader, carried out through `std::io::Error` (see [`Error::io`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LimitHit {
+    pub line: Option<usize>,
+    pub option: &'static str,
+    pub limit: u64,
+    pub what: &'static str,
+}
+
+impl LimitHit {
+    pub(crate) fn to_error(self, file: impl std::fmt::Display) -> Error {
+        Error::LimitExceeded {
+            file: file.to_string(),
+            line: self.line,
+            option: self.option,
+            limit: self.limit,
+            what: self.what,
+        }
+    }
+
+    pub(crate) fn into_io(self) -> std::io::Error {
+        std::io::Error::other(self)
+    }
+}
+
+impl std::fmt::Display for LimitHit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} exceeds the limit of {} (LoadOptions::{})",
+            self.what, self.limit, self.option
+        )
+    }
+}
+
+impl std::error::Error for LimitHit {}

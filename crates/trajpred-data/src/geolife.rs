@@ -52,8 +52,8 @@ pub fn parse_plt<R: BufRead>(
     report.files_read += 1;
     report.groups += 1;
     let mut points = Vec::new();
-    let mut c = Cleaner { opts, file, report };
-    for_each_line(reader, file, |line, text| {
+    let mut c = Cleaner::new(opts, file, report);
+    for_each_line(reader, file, opts, |line, text| {
         if line <= HEADER_LINES {
             c.report.header_lines += 1;
             return Ok(());
@@ -70,6 +70,7 @@ pub fn parse_plt<R: BufRead>(
         match parse_plt_line(text, line) {
             Ok(p) => {
                 if c.accept_geodetic(&p)? {
+                    c.hold(line, points.len())?;
                     points.push(p);
                 }
                 Ok(())
@@ -102,6 +103,14 @@ fn parse_plt_line(text: &str, line: usize) -> std::result::Result<RawPoint, Stri
 /// Loads one `.plt` file; the id is `user/stem` (the user being the folder above
 /// `Trajectory/`).
 pub fn load_plt(path: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadReport)> {
+    let mut report = LoadReport::new();
+    let tracks = load_plt_into(path, opts, &mut report)?;
+    Ok((tracks, report))
+}
+
+/// [`load_plt`] adding to `report` (whose kept points count towards
+/// [`LoadOptions::max_total_points`]).
+fn load_plt_into(path: &Path, opts: &LoadOptions, report: &mut LoadReport) -> Result<Vec<Track>> {
     let user = path
         .parent()
         .and_then(Path::parent)
@@ -109,10 +118,8 @@ pub fn load_plt(path: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadRepo
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
     let id = format!("{user}/{}", stem(path));
-    let mut report = LoadReport::new();
     let name = path.display().to_string();
-    let tracks = parse_plt(open(path)?, &name, &id, opts, &mut report)?;
-    Ok((tracks, report))
+    parse_plt(open(path)?, &name, &id, opts, report)
 }
 
 /// The `.plt` files of one user folder (`<user>/Trajectory/*.plt`), sorted.
@@ -122,16 +129,24 @@ pub fn plt_files(user_dir: &Path) -> Result<Vec<PathBuf>> {
     })
 }
 
-/// Loads every trajectory of one user folder.
+/// Loads every trajectory of one user folder; [`LoadOptions::max_total_points`] bounds the
+/// points of the whole folder.
 pub fn load_user(user_dir: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadReport)> {
-    let mut tracks = Vec::new();
     let mut report = LoadReport::new();
-    for f in plt_files(user_dir)? {
-        let (t, r) = load_plt(&f, opts)?;
-        tracks.extend(t);
-        report.merge(r);
-    }
+    let tracks = load_user_into(user_dir, opts, &mut report)?;
     Ok((tracks, report))
+}
+
+fn load_user_into(
+    user_dir: &Path,
+    opts: &LoadOptions,
+    report: &mut LoadReport,
+) -> Result<Vec<Track>> {
+    let mut tracks = Vec::new();
+    for f in plt_files(user_dir)? {
+        tracks.extend(load_plt_into(&f, opts, report)?);
+    }
+    Ok(tracks)
 }
 
 /// The user folders (those holding a `Trajectory/` folder) of a GeoLife `Data/` folder, or
@@ -146,14 +161,12 @@ pub fn user_dirs(data_dir: &Path) -> Result<Vec<PathBuf>> {
 }
 
 /// Loads every user of a GeoLife `Data/` folder or of the dataset's root (see
-/// [`user_dirs`]).
+/// [`user_dirs`]); [`LoadOptions::max_total_points`] bounds the points of the whole load.
 pub fn load_data_dir(data_dir: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadReport)> {
     let mut tracks = Vec::new();
     let mut report = LoadReport::new();
     for u in user_dirs(data_dir)? {
-        let (t, r) = load_user(&u, opts)?;
-        tracks.extend(t);
-        report.merge(r);
+        tracks.extend(load_user_into(&u, opts, &mut report)?);
     }
     Ok((tracks, report))
 }
@@ -185,12 +198,8 @@ pub fn parse_labels<R: BufRead>(
     let mut report = LoadReport::new();
     report.files_read += 1;
     let mut labels = Vec::new();
-    let mut c = Cleaner {
-        opts: &opts,
-        file,
-        report: &mut report,
-    };
-    for_each_line(reader, file, |line, text| {
+    let mut c = Cleaner::new(&opts, file, &mut report);
+    for_each_line(reader, file, &opts, |line, text| {
         if line == 1 {
             c.report.header_lines += 1;
             return Ok(());
@@ -213,6 +222,8 @@ pub fn parse_labels<R: BufRead>(
         }
         match (parse_datetime(f[0]), parse_datetime(f[1])) {
             (Some(start), Some(end)) if end >= start && !f[2].trim().is_empty() => {
+                c.hold(line, labels.len())?;
+                c.release(1);
                 c.report.points_kept += 1;
                 labels.push(Label {
                     start,

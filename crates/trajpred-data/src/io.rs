@@ -1,33 +1,66 @@
 //! Line reading and file listing shared by the loaders.
 
-use crate::error::{Error, Result};
+use crate::error::{Error, LimitHit, Result};
+use crate::track::LoadOptions;
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
 /// Calls `f(line_number, text)` for every line of `reader` (1-based), with the line ending
 /// (`\n` or `\r\n`) removed; `text` is `None` for a line that is not valid UTF-8.
+///
+/// Streams: at most one line (of at most `opts.max_line_bytes` bytes, line end excluded) is
+/// held. A longer line, or more than `opts.max_file_bytes` bytes in all (decompressed), is an
+/// [`Error::LimitExceeded`] naming the line.
 pub(crate) fn for_each_line<R: BufRead>(
     mut reader: R,
     file: &str,
+    opts: &LoadOptions,
     mut f: impl FnMut(usize, Option<&str>) -> Result<()>,
 ) -> Result<()> {
+    let max_line = opts.max_line_bytes;
+    // the longest read that can still be an acceptable line: the line, `\r` and `\n`
+    let read_cap = u64::try_from(max_line)
+        .unwrap_or(u64::MAX)
+        .saturating_add(2);
     let mut buf = Vec::with_capacity(256);
     let mut line = 0;
+    let mut total: u64 = 0;
     loop {
         buf.clear();
-        let n = reader
+        let n = (&mut reader)
+            .take(read_cap)
             .read_until(b'\n', &mut buf)
             .map_err(|e| Error::io(file, e))?;
         if n == 0 {
             return Ok(());
         }
         line += 1;
-        if buf.last() == Some(&b'\n') {
+        total = total.saturating_add(n as u64);
+        if total > opts.max_file_bytes {
+            return Err(LimitHit {
+                line: Some(line),
+                option: "max_file_bytes",
+                limit: opts.max_file_bytes,
+                what: "decompressed size in bytes",
+            }
+            .to_error(file));
+        }
+        let ended = buf.last() == Some(&b'\n');
+        if ended {
             buf.pop();
         }
         if buf.last() == Some(&b'\r') {
             buf.pop();
+        }
+        if buf.len() > max_line {
+            return Err(LimitHit {
+                line: Some(line),
+                option: "max_line_bytes",
+                limit: max_line as u64,
+                what: "line length in bytes",
+            }
+            .to_error(file));
         }
         f(line, std::str::from_utf8(&buf).ok())?;
     }
@@ -50,12 +83,26 @@ pub(crate) fn open(path: &Path) -> Result<Box<dyn BufRead>> {
     }
 }
 
-/// Reads a whole (possibly gzip-compressed) file into bytes.
-pub(crate) fn read_all(path: &Path) -> Result<Vec<u8>> {
+/// Reads a whole (possibly gzip-compressed) file into bytes, at most `max_bytes` of them
+/// (decompressed): a longer file is an [`Error::LimitExceeded`] for `option`, read no further.
+pub(crate) fn read_all(path: &Path, max_bytes: u64, option: &'static str) -> Result<Vec<u8>> {
+    let io_err = |e| Error::io(path.display(), e);
+    let mut reader = open(path)?;
     let mut out = Vec::new();
-    open(path)?
+    // at most `max_bytes` into memory, then one byte more tells a larger file
+    (&mut reader)
+        .take(max_bytes)
         .read_to_end(&mut out)
-        .map_err(|e| Error::io(path.display(), e))?;
+        .map_err(io_err)?;
+    if out.len() as u64 == max_bytes && reader.read(&mut [0u8]).map_err(io_err)? > 0 {
+        return Err(LimitHit {
+            line: None,
+            option,
+            limit: max_bytes,
+            what: "decompressed size in bytes",
+        }
+        .to_error(path.display()));
+    }
     Ok(out)
 }
 

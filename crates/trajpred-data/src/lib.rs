@@ -10,7 +10,9 @@
 //!   package's JSON, both layouts, gzip) and [`csvfile`] (`t,x,y[,z]` or `t,lat,lon[,alt]`,
 //!   optional track column, seconds, epoch milliseconds or ISO 8601 times);
 //!   configured by [`LoadOptions`] (projection, altitude, bounding box, gap split, minimum
-//!   length, strictness); each loads one file or folder at a time, so memory stays bounded;
+//!   length, strictness, and the limits on line length, decompressed bytes and points that
+//!   stop a malicious or broken file with [`Error::LimitExceeded`]); each loads one file or
+//!   folder at a time, streaming text, so memory stays bounded;
 //! - [`segment`]: split on gaps, keep long trajectories, resample to a fixed step;
 //! - [`geodesy`]: WGS84 latitude/longitude/altitude to a local east-north-up frame (via ECEF,
 //!   exact) and back;
@@ -52,4 +54,7 @@ pub mod track;
 pub use error::{Error, Result};
 pub use report::{LoadReport, Skip, SkipReason};
 pub use time::TimeUnit;
-pub use track::{BoundingBox, Frame, LoadOptions, Projection, Track};
+pub use track::{
+    BoundingBox, Frame, LoadOptions, MAX_FILE_BYTES, MAX_JSON_BYTES, MAX_LINE_BYTES,
+    MAX_TOTAL_POINTS, MAX_TRACK_POINTS, Projection, Track,
+};

@@ -47,8 +47,8 @@ pub fn parse<R: BufRead>(
     // the previous line, for the duplicate check (`None` after an undecodable line)
     let mut previous = String::new();
     let mut have_previous = false;
-    let mut c = Cleaner { opts, file, report };
-    for_each_line(reader, file, |line, text| {
+    let mut c = Cleaner::new(opts, file, report);
+    for_each_line(reader, file, opts, |line, text| {
         let Some(text) = text else {
             c.report.records_read += 1;
             have_previous = false;
@@ -101,6 +101,7 @@ pub fn parse<R: BufRead>(
             alt: None,
         };
         if c.accept_geodetic(&p)? {
+            c.hold(line, points.len())?;
             points.push(p);
         }
         Ok(())
@@ -134,14 +135,18 @@ pub fn files(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(v)
 }
 
-/// Loads every taxi file of a folder, or of the dataset's root folder (see [`files`]).
+/// Loads every taxi file of a folder, or of the dataset's root folder (see [`files`]);
+/// [`LoadOptions::max_total_points`] bounds the points of the whole folder.
 pub fn load_dir(dir: &Path, opts: &LoadOptions) -> Result<(Vec<Track>, LoadReport)> {
     let mut tracks = Vec::new();
     let mut report = LoadReport::new();
     for f in files(dir)? {
-        let (t, r) = load_file(&f, opts)?;
-        tracks.extend(t);
-        report.merge(r);
+        tracks.extend(parse(
+            open(&f)?,
+            &f.display().to_string(),
+            opts,
+            &mut report,
+        )?);
     }
     Ok((tracks, report))
 }

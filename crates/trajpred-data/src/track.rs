@@ -103,7 +103,40 @@ pub struct LoadOptions {
     /// Fail on the first malformed line or invalid coordinate with
     /// [`Error::Parse`] instead of skipping it (default `false`).
     pub strict: bool,
+    /// The longest line of a text format (GeoLife, T-Drive, CSV), in bytes without the line
+    /// end (default [`MAX_LINE_BYTES`], 1 MiB). A longer line is an
+    /// [`Error::LimitExceeded`] naming the file and line; the loaders never hold more than
+    /// one line of this length.
+    pub max_line_bytes: usize,
+    /// The most bytes read from one text file, after gzip decompression (default
+    /// [`MAX_FILE_BYTES`], 4 GiB). Text formats are streamed, so this bounds time, not
+    /// memory; it stops a gzip bomb early.
+    pub max_file_bytes: u64,
+    /// The most bytes of one JSON file (ADS-B), after decompression (default
+    /// [`MAX_JSON_BYTES`], 512 MiB). A JSON document is read whole before it is parsed, so
+    /// this bounds the memory a file can take.
+    pub max_json_bytes: u64,
+    /// The most points one trajectory (before splitting at gaps) may hold while it is read
+    /// (default [`MAX_TRACK_POINTS`], 10 million).
+    pub max_track_points: usize,
+    /// The most points one load call may hold: a `load_*` function over a file or folder,
+    /// or a `parse*` function, counting the points already kept in the report it is given
+    /// (default [`MAX_TOTAL_POINTS`], 50 million). For ADS-B JSON the records read count,
+    /// since they are all held before grouping.
+    pub max_total_points: usize,
 }
+
+/// Default [`LoadOptions::max_line_bytes`]: 1 MiB (a GeoLife line is about 65 bytes).
+pub const MAX_LINE_BYTES: usize = 1 << 20;
+/// Default [`LoadOptions::max_file_bytes`]: 4 GiB of decompressed text per file.
+pub const MAX_FILE_BYTES: u64 = 4 << 30;
+/// Default [`LoadOptions::max_json_bytes`]: 512 MiB of decompressed JSON per file.
+pub const MAX_JSON_BYTES: u64 = 512 << 20;
+/// Default [`LoadOptions::max_track_points`]: 10 million points in one trajectory.
+pub const MAX_TRACK_POINTS: usize = 10_000_000;
+/// Default [`LoadOptions::max_total_points`]: 50 million points in one load (GeoLife 1.3
+/// has 24.9 million, T-Drive 17.7 million).
+pub const MAX_TOTAL_POINTS: usize = 50_000_000;
 
 impl Default for LoadOptions {
     fn default() -> Self {
@@ -115,6 +148,11 @@ impl Default for LoadOptions {
             max_gap: None,
             min_points: 1,
             strict: false,
+            max_line_bytes: MAX_LINE_BYTES,
+            max_file_bytes: MAX_FILE_BYTES,
+            max_json_bytes: MAX_JSON_BYTES,
+            max_track_points: MAX_TRACK_POINTS,
+            max_total_points: MAX_TOTAL_POINTS,
         }
     }
 }
@@ -143,7 +181,8 @@ impl LoadOptions {
         }
     }
 
-    /// Checks the parameters (a positive `max_gap`, `min_points` ≥ 1, a valid reference).
+    /// Checks the parameters (a positive `max_gap`, `min_points` ≥ 1, a valid reference,
+    /// limits of at least one line byte and one point).
     pub fn validate(&self) -> Result<()> {
         if let Some(g) = self.max_gap
             && !(g.is_finite() && g > 0.0)
@@ -158,6 +197,15 @@ impl LoadOptions {
         }
         if let Projection::Enu(o) = self.projection {
             LocalFrame::new(o)?;
+        }
+        if self.max_line_bytes == 0 {
+            return Err(Error::param("max_line_bytes", "must be at least 1"));
+        }
+        if self.max_track_points == 0 {
+            return Err(Error::param("max_track_points", "must be at least 1"));
+        }
+        if self.max_total_points == 0 {
+            return Err(Error::param("max_total_points", "must be at least 1"));
         }
         Ok(())
     }
@@ -205,9 +253,59 @@ pub(crate) struct Cleaner<'a> {
     pub opts: &'a LoadOptions,
     pub file: &'a str,
     pub report: &'a mut LoadReport,
+    /// Points (or, for JSON, records) held and not yet passed to [`Cleaner::finish`].
+    held: usize,
 }
 
-impl Cleaner<'_> {
+impl<'a> Cleaner<'a> {
+    pub fn new(opts: &'a LoadOptions, file: &'a str, report: &'a mut LoadReport) -> Self {
+        Cleaner {
+            opts,
+            file,
+            report,
+            held: 0,
+        }
+    }
+
+    /// Counts one more point held at `line`, in a trajectory already holding `track_len`
+    /// points: an [`Error::LimitExceeded`] when that crosses
+    /// [`LoadOptions::max_track_points`] or [`LoadOptions::max_total_points`].
+    pub fn hold(&mut self, line: usize, track_len: usize) -> Result<()> {
+        if track_len >= self.opts.max_track_points {
+            return Err(self.limit(
+                line,
+                "max_track_points",
+                self.opts.max_track_points,
+                "points in one trajectory",
+            ));
+        }
+        self.held += 1;
+        if self.report.points_kept.saturating_add(self.held) > self.opts.max_total_points {
+            return Err(self.limit(
+                line,
+                "max_total_points",
+                self.opts.max_total_points,
+                "points in one load",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Forgets `n` held points (records turned into points, or points passed on).
+    pub fn release(&mut self, n: usize) {
+        self.held = self.held.saturating_sub(n);
+    }
+
+    fn limit(&self, line: usize, option: &'static str, limit: usize, what: &'static str) -> Error {
+        Error::LimitExceeded {
+            file: self.file.to_string(),
+            line: Some(line),
+            option,
+            limit: limit as u64,
+            what,
+        }
+    }
+
     /// A malformed line: skipped and counted, or an error in strict mode.
     pub fn malformed(&mut self, line: usize, reason: impl Into<String>) -> Result<()> {
         let reason = reason.into();
@@ -290,6 +388,7 @@ impl Cleaner<'_> {
         frame_kind: FrameKind,
         out: &mut Vec<Track>,
     ) -> Result<()> {
+        self.release(points.len());
         if points.is_empty() {
             return Ok(());
         }

@@ -51,7 +51,8 @@ pub trait Resampler {
     /// necessarily normalised) into `out`, without allocating.
     ///
     /// Errors: [`ParticleError::Empty`] (no weights), [`ParticleError::InvalidWeight`]
-    /// (negative or non-finite), [`ParticleError::AllWeightsZero`],
+    /// (negative or non-finite), [`ParticleError::AllWeightsZero`] (also for weights that
+    /// underflowed: a total that is subnormal or below `n / f64::MAX`),
     /// [`ParticleError::NonFinite`] (the sum of the weights overflows).
     fn resample_into<R: Rng + ?Sized>(
         &self,
@@ -106,7 +107,13 @@ fn sum_and_sign(weights: &[f64], total: &mut f64, negative: &mut bool) {
     }
 }
 
-fn check_weights(weights: &[f64]) -> Result<Checked> {
+/// Checks `weights` for `n` output slots: non-empty, finite, non-negative, with a finite sum
+/// that is a normal number and at least `n / f64::MAX`, so that the scale `n / W` the
+/// schemes work with is finite. A smaller (subnormal) total means the weights underflowed:
+/// it is reported as [`ParticleError::AllWeightsZero`], checked once here at entry instead
+/// of in the passes over the weights (where `n / W = inf` made `w n / W` infinite or NaN and
+/// the counts read from it garbage).
+fn check_weights(weights: &[f64], n: usize) -> Result<Checked> {
     if weights.is_empty() {
         return Err(ParticleError::Empty { what: "weights" });
     }
@@ -135,7 +142,7 @@ fn check_weights(weights: &[f64]) -> Result<Checked> {
     // non-negative weights with a zero sum are all zero
     let last = weights.iter().rposition(|&v| v > 0.0);
     match last {
-        Some(last) if total > 0.0 => Ok(Checked {
+        Some(last) if scale_ok(total, n) => Ok(Checked {
             total,
             last,
             mid,
@@ -145,6 +152,12 @@ fn check_weights(weights: &[f64]) -> Result<Checked> {
             count: weights.len(),
         }),
     }
+}
+
+/// Whether `n / total` is finite for a normal, positive `total`.
+#[inline]
+fn scale_ok(total: f64, n: usize) -> bool {
+    total.is_normal() && total > 0.0 && (n as f64 / total).is_finite()
 }
 
 fn check_uniform(index: usize, value: f64) -> Result<()> {
@@ -194,7 +207,7 @@ fn merge_sorted(
 /// # Ok::<(), trajpred_particle::ParticleError>(())
 /// ```
 pub fn systematic_indices(weights: &[f64], offset: f64, out: &mut [usize]) -> Result<()> {
-    let c = check_weights(weights)?;
+    let c = check_weights(weights, out.len())?;
     check_uniform(0, offset)?;
     systematic_counts(weights, c, offset, out);
     Ok(())
@@ -360,7 +373,7 @@ impl SystematicCount {
 /// `(j + u_j) / n`. Errors with [`ParticleError::LengthMismatch`] unless
 /// `uniforms.len() == out.len()`, [`ParticleError::InvalidUniform`] outside `[0, 1]`.
 pub fn stratified_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) -> Result<()> {
-    let c = check_weights(weights)?;
+    let c = check_weights(weights, out.len())?;
     if uniforms.len() != out.len() {
         return Err(ParticleError::LengthMismatch {
             what: "uniforms vs output",
@@ -393,7 +406,7 @@ fn search(cumsum: &[f64], p: f64, last: usize) -> usize {
 /// on exact ties `u_j = C_i`, where filterpy picks `i` and this picks the next particle of
 /// positive weight (so a zero weight is never selected, even for `u = 0`).
 pub fn multinomial_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) -> Result<()> {
-    let c = check_weights(weights)?;
+    let c = check_weights(weights, out.len())?;
     if uniforms.len() != out.len() {
         return Err(ParticleError::LengthMismatch {
             what: "uniforms vs output",
@@ -434,7 +447,7 @@ pub fn multinomial_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize])
 /// # Ok::<(), trajpred_particle::ParticleError>(())
 /// ```
 pub fn residual_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) -> Result<usize> {
-    let c = check_weights(weights)?;
+    let c = check_weights(weights, out.len())?;
     let n = out.len();
     let scale = n as f64 / c.total;
     let (k, _, _) = write_copies(weights, scale, out);
@@ -633,7 +646,7 @@ impl Resampler for Stratified {
         rng: &mut R,
         out: &mut [usize],
     ) -> Result<()> {
-        let c = check_weights(weights)?;
+        let c = check_weights(weights, out.len())?;
         let nf = out.len() as f64;
         let total = c.total;
         merge_sorted(weights, c.last, out, |j| {
@@ -659,7 +672,7 @@ impl Resampler for Multinomial {
         rng: &mut R,
         out: &mut [usize],
     ) -> Result<()> {
-        let c = check_weights(weights)?;
+        let c = check_weights(weights, out.len())?;
         sorted_multinomial(rng, |i| weights[i], weights.len(), c.total, c.last, out);
         Ok(())
     }
@@ -687,7 +700,7 @@ impl Resampler for Residual {
         let n = out.len();
         let mut parts = [Part::default(); PARTS_MAX];
         let parts = &mut parts[..part_count(weights.len())];
-        let scale = n as f64 / residual_total(weights, parts)?;
+        let scale = n as f64 / residual_total(weights, parts, n)?;
         let sums = residual_part_sums(weights, scale, parts);
         if sums.copies >= n {
             // no remainder (or, by rounding, copies for more than n places: clamped)
@@ -1037,11 +1050,11 @@ fn part_count(len: usize) -> usize {
 /// scheme needs `W` only as the scale `n / W`, not as the end point of the running sums
 /// the merge schemes share. A negative, non-finite or all-zero input is reported by
 /// [`check_weights`].
-fn residual_total(weights: &[f64], parts: &mut [Part]) -> Result<f64> {
+fn residual_total(weights: &[f64], parts: &mut [Part], n: usize) -> Result<f64> {
     let len = weights.len();
     if let [part] = parts {
         part.end = len;
-        return Ok(check_weights(weights)?.total);
+        return Ok(check_weights(weights, n)?.total);
     }
     let size = len.div_ceil(parts.len()).div_ceil(BLOCK) * BLOCK;
     for (j, part) in parts.iter_mut().enumerate() {
@@ -1073,12 +1086,12 @@ fn residual_total(weights: &[f64], parts: &mut [Part]) -> Result<f64> {
         };
     });
     let total: f64 = parts.iter().map(|p| p.weight_sum).sum();
-    if total.is_finite() && total > 0.0 {
+    if total.is_finite() && scale_ok(total, n) {
         Ok(total)
     } else {
         // the error, located (or, should only this order of additions overflow, the
         // sequential sum)
-        Ok(check_weights(weights)?.total)
+        Ok(check_weights(weights, n)?.total)
     }
 }
 

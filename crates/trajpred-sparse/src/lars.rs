@@ -231,7 +231,11 @@ impl LarsParams {
     /// Computes the path for design `x` (n x p, one row per sample) and target `y` (length n).
     ///
     /// Errors: [`Error::Empty`] for no rows or no columns, [`Error::DimensionMismatch`] if
-    /// `y.len() != n`, [`Error::NonFinite`] for NaN or infinite input,
+    /// `y.len() != n`, [`Error::NonFinite`] for NaN or infinite input, for a target whose sum
+    /// or (centred) squared norm overflows `f64` (`row` is where the running sum overflows;
+    /// values beyond about 1e154 in magnitude), and for a path whose alphas, coefficients or
+    /// intercepts overflow; [`Error::Overflow`] for a design column whose squared norm, mean
+    /// or centred norm overflows;
     /// [`Error::AllColumnsConstant`] when no column can enter, [`Error::InvalidParameter`]
     /// for a bad setting.
     pub fn fit(&self, x: &DMatrix<f64>, y: &[f64]) -> Result<Lars> {
@@ -297,6 +301,9 @@ impl LarsParams {
                     xs.column_mut(j).iter_mut().for_each(|v| *v -= m);
                 }
                 norm = xs.column(j).norm();
+                if !(x_mean[j].is_finite() && norm.is_finite()) {
+                    return Err(Error::Overflow { col: j });
+                }
             }
             // a constant column leaves only rounding (~ n eps |x|) after centring
             if raw_norm == 0.0 || norm <= 1e-10 * raw_norm {
@@ -327,7 +334,22 @@ impl LarsParams {
         } else {
             0.0
         };
+        if !y_mean.is_finite() {
+            return Err(Error::NonFinite {
+                what: "target sum (it overflows f64: rescale y)",
+                row: first_overflow(y.iter().copied()),
+                col: 0,
+            });
+        }
         let ys: Vec<f64> = y.iter().map(|v| v - y_mean).collect();
+        // every correlation is bounded by |x_j| |y|: a finite squared norm keeps them finite
+        if !crate::cholesky::dot(&ys, &ys).is_finite() {
+            return Err(Error::NonFinite {
+                what: "centred target's squared norm (it overflows f64: rescale y)",
+                row: first_overflow(ys.iter().map(|v| v * v)),
+                col: 0,
+            });
+        }
 
         let use_gram = match self.gram {
             Gram::Auto => p <= n && p <= 4096,
@@ -353,9 +375,37 @@ impl LarsParams {
         let knots = path.alphas.len();
         let std_path = DMatrix::from_fn(knots, p, |k, j| path.coefs[k][j]);
         let coef_path = DMatrix::from_fn(knots, p, |k, j| path.coefs[k][j] / x_scale[j]);
-        let intercepts = (0..knots)
+        let intercepts: Vec<f64> = (0..knots)
             .map(|k| y_mean - (0..p).map(|j| coef_path[(k, j)] * x_mean[j]).sum::<f64>())
             .collect();
+        // whatever overflowed inside the path shows in its output: an error, never inf or NaN
+        let bad_coef = |m: &DMatrix<f64>| {
+            (0..knots)
+                .flat_map(|k| (0..p).map(move |j| (k, j)))
+                .find(|&(k, j)| !m[(k, j)].is_finite())
+        };
+        if let Some(k) = path.alphas.iter().position(|a| !a.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "path alphas (an intermediate value overflowed: rescale X or y)",
+                row: k,
+                col: 0,
+            });
+        }
+        if let Some((k, j)) = bad_coef(&std_path).or_else(|| bad_coef(&coef_path)) {
+            return Err(Error::NonFinite {
+                what: "path coefficients (knot, feature; an intermediate value overflowed: \
+                       rescale X or y)",
+                row: k,
+                col: j,
+            });
+        }
+        if let Some(k) = intercepts.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "path intercepts (an intermediate value overflowed: rescale X or y)",
+                row: k,
+                col: 0,
+            });
+        }
         Ok(Lars {
             params: self.clone(),
             n_features: p,
@@ -372,6 +422,21 @@ impl LarsParams {
             y_mean,
         })
     }
+}
+
+/// The index at which the running sum of `values` first stops being finite (the last index if
+/// it never does).
+fn first_overflow(values: impl Iterator<Item = f64>) -> usize {
+    let mut sum = 0.0;
+    let mut last = 0;
+    for (i, v) in values.enumerate() {
+        sum += v;
+        last = i;
+        if !sum.is_finite() {
+            return i;
+        }
+    }
+    last
 }
 
 /// A fitted LARS path: every knot, the events that changed the active set, and the final

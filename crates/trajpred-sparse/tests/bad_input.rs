@@ -205,3 +205,66 @@ fn overflowing_column_is_reported() {
         Error::Overflow { col: 2 }
     );
 }
+
+/// A target whose sum overflows used to give an infinite intercept and no error; now the
+/// overflow is a `NonFinite` naming the target and the row where the running sum overflows.
+#[test]
+fn overflowing_target_is_an_error_not_inf() {
+    let (x, _) = small();
+    let y = vec![1e308; 5];
+    match Lars::params().fit(&x, &y) {
+        Err(Error::NonFinite {
+            what,
+            row: 1,
+            col: 0,
+        }) => {
+            assert!(what.contains("target sum"), "{what}")
+        }
+        other => panic!("{other:?}"),
+    }
+    // without an intercept the sum is not needed, but the squared norm overflows
+    match Lars::params().fit_intercept(false).fit(&x, &y) {
+        Err(Error::NonFinite {
+            what,
+            row: 0,
+            col: 0,
+        }) => {
+            assert!(what.contains("squared norm"), "{what}")
+        }
+        other => panic!("{other:?}"),
+    }
+    // a finite mean, but the centred values' squares overflow
+    let y = vec![1e200, -1e200, 1e200, -1e200, 0.0];
+    match Lars::params().fit(&x, &y) {
+        Err(Error::NonFinite {
+            what,
+            row: 0,
+            col: 0,
+        }) => {
+            assert!(what.contains("squared norm"), "{what}")
+        }
+        other => panic!("{other:?}"),
+    }
+    // large but representable: a finite path
+    let y: Vec<f64> = [1.0, 2.0, 4.0, 3.0, 6.0]
+        .iter()
+        .map(|v| v * 1e150)
+        .collect();
+    let fit = Lars::params().fit(&x, &y).unwrap();
+    assert!(fit.coef_path().iter().all(|v| v.is_finite()));
+    assert!(fit.intercepts().iter().all(|v| v.is_finite()));
+    assert!(fit.alphas().iter().all(|v| v.is_finite()));
+}
+
+/// Tiny columns (norm ~1e-160) with a huge target: the standardised path is finite but its
+/// coefficients on the original scale overflow; that is an error naming the path.
+#[test]
+fn overflowing_path_is_an_error_not_inf() {
+    let (x, y) = small();
+    let x = x.map(|v| v * 1e-160);
+    let y: Vec<f64> = y.iter().map(|v| v * 1e150).collect();
+    match Lars::params().fit(&x, &y) {
+        Err(Error::NonFinite { what, .. }) => assert!(what.contains("path"), "{what}"),
+        other => panic!("{other:?}"),
+    }
+}
