@@ -166,6 +166,16 @@ pub trait Predictor: Send + Sync {
     /// Predicts `horizon` steps after the last point of `history`.
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast>;
 
+    /// Predicts the positions at the future `times` (seconds, increasing, after the
+    /// history's last time): "where will it be at 12:00:05". The default answers with
+    /// [`Predictor::forecast`] of `times.len()` steps on the method's own time grid (the
+    /// history's mean interval), for methods that step by index; methods that model time
+    /// override it. The evaluation harness asks at the timestamps of the points it scores
+    /// against: their times, never their positions.
+    fn forecast_times(&self, history: &Trajectory, times: &[f64]) -> Result<Forecast> {
+        self.forecast(history, times.len())
+    }
+
     /// The shortest history `forecast` accepts.
     fn min_history(&self) -> usize {
         1
@@ -187,6 +197,9 @@ impl<P: Predictor + ?Sized> Predictor for Box<P> {
     }
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
         (**self).forecast(history, horizon)
+    }
+    fn forecast_times(&self, history: &Trajectory, times: &[f64]) -> Result<Forecast> {
+        (**self).forecast_times(history, times)
     }
     fn min_history(&self) -> usize {
         (**self).min_history()

@@ -174,8 +174,23 @@ pub fn load_tracks(
     let take = max_units.unwrap_or(usize::MAX).min(units_total);
     let mut report = LoadReport::new();
     let mut tracks = Vec::new();
+    let mut total = 0usize;
     for unit in &units[..take] {
         let (t, r) = dataset.load_unit(unit, opts)?;
+        total += t.iter().map(|t| t.trajectory.len()).sum::<usize>();
+        // the loaders bound one unit; the whole dataset is bounded here
+        if total > opts.max_total_points {
+            return Err(Error::InvalidParameter {
+                name: "max_total_points",
+                reason: format!(
+                    "{} holds more than {} points (reached at {}); raise the limit \
+                     (--max-total-points) or read fewer units (--max-units)",
+                    path.display(),
+                    opts.max_total_points,
+                    unit.display()
+                ),
+            });
+        }
         tracks.extend(t);
         report.merge(r);
     }

@@ -4,7 +4,8 @@
 //! For every test trajectory and every origin `o` (from `history - 1`, every `stride` points,
 //! while `o + horizon` is inside the trajectory) the predictor gets the `history` points
 //! ending at `o` and forecasts `horizon` steps; these are scored against the points
-//! `o + 1 ..= o + horizon`. Trajectories are processed in parallel (rayon) in fixed-size
+//! `o + 1 ..= o + horizon`, asked for at those points' timestamps
+//! ([`Predictor::forecast_times`]: their times, never their positions). Trajectories are processed in parallel (rayon) in fixed-size
 //! chunks and their partial sums are combined in trajectory order, so results do not depend
 //! on the number of threads and memory holds one chunk of trajectories at a time.
 
@@ -173,7 +174,8 @@ fn evaluate_one(p: &dyn Predictor, tr: &Trajectory, cfg: &EvalConfig) -> Sums {
                 continue;
             }
         };
-        match p.forecast(&history, cfg.horizon) {
+        let times = &tr.times()[o + 1..=o + cfg.horizon];
+        match p.forecast_times(&history, times) {
             Ok(f) if f.horizon() == cfg.horizon && f.dim() == tr.dim() => {
                 let predicted: Vec<Point> = f.points().collect();
                 let truth: Vec<Point> = (1..=cfg.horizon).map(|k| tr.point(o + k)).collect();

@@ -63,6 +63,14 @@ pub const METHODS: &[MethodInfo] = &[
         description: "naive KF with the 4-D position + velocity observation (R = I)",
     },
     MethodInfo {
+        name: "kf-cv",
+        description: "Kalman filter over actual time: constant velocity, continuous white-noise acceleration, q and r fitted by maximum likelihood",
+    },
+    MethodInfo {
+        name: "kf-ca",
+        description: "Kalman filter over actual time: constant acceleration, continuous white-noise jerk, q and r fitted by maximum likelihood",
+    },
+    MethodInfo {
         name: "poly1",
         description: "least-squares line through the last N points, extrapolated",
     },
@@ -170,6 +178,10 @@ pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
         "naive-kf-4d" => Box::new(NaiveKf::new(KfDynamicParams::paper_position_velocity(
             opts.kf_q,
         ))?),
+        "kf-cv" | "kf-ca" => Box::new(KfTime::new(KfTimeParams {
+            derivatives: if name == "kf-cv" { 2 } else { 3 },
+            ..Default::default()
+        })?),
         "poly1" | "poly2" => Box::new(PolyFit::new(PolyFitParams {
             degree: if name == "poly1" { 1 } else { 2 },
             points: opts.poly_points,

@@ -412,3 +412,43 @@ fn predict_prints_the_frame_origin_and_times_steps_by_the_mean_interval() {
     assert_eq!(t1 - t0, 2.0);
     assert!(v["steps"][1]["lat_deg"].as_f64().is_some());
 }
+
+#[test]
+fn a_huge_horizon_is_refused_before_any_model_is_sized_by_it() {
+    let dir = scratch("horizon");
+    write_csv_folder(&dir);
+    let file = dir.join("mon.csv");
+    for method in ["gskf", "kf-dynamic", "lstm"] {
+        let out = run(&[
+            "predict",
+            "--input",
+            file.to_str().expect("path"),
+            "--method",
+            method,
+            "--horizon",
+            "100000000000",
+        ]);
+        assert_eq!(out.status.code(), Some(1), "{method}");
+        let err = text(&out.stderr);
+        assert!(
+            err.contains("--horizon must be between 1 and 100000"),
+            "{err}"
+        );
+    }
+    // a limit on the loaders, raised or lowered from the command line
+    let out = run(&[
+        "predict",
+        "--input",
+        file.to_str().expect("path"),
+        "--method",
+        "poly1",
+        "--max-line-bytes",
+        "10",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains("max_line_bytes"),
+        "{}",
+        text(&out.stderr)
+    );
+}

@@ -13,9 +13,10 @@ use trajpred::harness::{MethodReport, Split};
 use trajpred::plot::{Chart, Series, write_chart};
 use trajpred::protocol::{self, MethodSpec, Progress, Protocol};
 use trajpred::registry::{MethodOptions, all_methods, build};
+use trajpred_core::MAX_HORIZON;
 use trajpred_core::{Forecast, Trajectory};
-use trajpred_data::Frame;
 use trajpred_data::geodesy::{Enu, LocalFrame};
+use trajpred_data::{Frame, LoadOptions};
 
 #[derive(Parser)]
 #[command(
@@ -63,6 +64,48 @@ impl SegmentArgs {
     }
 }
 
+/// Limits on what the loaders read (each has a default; a crossed limit is an error naming
+/// the file, the line and the option to raise).
+#[derive(clap::Args, Clone)]
+struct LimitArgs {
+    /// Longest line read, bytes.
+    #[arg(long, default_value_t = trajpred_data::MAX_LINE_BYTES)]
+    max_line_bytes: usize,
+    /// Most decompressed bytes read from one text file.
+    #[arg(long, default_value_t = trajpred_data::MAX_FILE_BYTES)]
+    max_file_bytes: u64,
+    /// Most decompressed bytes read from one JSON file (read whole).
+    #[arg(long, default_value_t = trajpred_data::MAX_JSON_BYTES)]
+    max_json_bytes: u64,
+    /// Most points in one track.
+    #[arg(long, default_value_t = trajpred_data::MAX_TRACK_POINTS)]
+    max_track_points: usize,
+    /// Most points loaded in all.
+    #[arg(long, default_value_t = trajpred_data::MAX_TOTAL_POINTS)]
+    max_total_points: usize,
+}
+
+impl LimitArgs {
+    fn apply(&self, opts: LoadOptions) -> LoadOptions {
+        LoadOptions {
+            max_line_bytes: self.max_line_bytes,
+            max_file_bytes: self.max_file_bytes,
+            max_json_bytes: self.max_json_bytes,
+            max_track_points: self.max_track_points,
+            max_total_points: self.max_total_points,
+            ..opts
+        }
+    }
+}
+
+/// A horizon within the stated limit, checked before any model is sized by it.
+fn check_horizon(horizon: usize) -> Result<()> {
+    if horizon == 0 || horizon > MAX_HORIZON {
+        bail!("--horizon must be between 1 and {MAX_HORIZON}, got {horizon}");
+    }
+    Ok(())
+}
+
 #[derive(clap::Args)]
 struct Input {
     /// Input file or folder.
@@ -76,6 +119,8 @@ struct Input {
     track: usize,
     #[command(flatten)]
     segment: SegmentArgs,
+    #[command(flatten)]
+    limits: LimitArgs,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -141,6 +186,8 @@ enum Command {
         max_origins: Option<usize>,
         #[command(flatten)]
         segment: SegmentArgs,
+        #[command(flatten)]
+        limits: LimitArgs,
         /// Read at most this many units (GeoLife users, T-Drive taxis, files).
         #[arg(long)]
         max_units: Option<usize>,
@@ -200,7 +247,8 @@ enum Command {
 fn load_one(input: &Input) -> Result<Segment> {
     let ds: Dataset = input.dataset.parse()?;
     let seg = input.segment.segmentation(1);
-    let loaded = dataset::load(ds, &input.input, &ds.options(), &seg, None)
+    let opts = input.limits.apply(ds.options());
+    let loaded = dataset::load(ds, &input.input, &opts, &seg, None)
         .with_context(|| format!("cannot load {}", input.input.display()))?;
     say_skips(&loaded);
     let n = loaded.segments.len();
@@ -506,6 +554,7 @@ fn run(cli: Cli) -> Result<()> {
             output,
         } => {
             // a bad method or horizon fails before the loading
+            check_horizon(horizon)?;
             build(&method, &method_options(horizon))?;
             let seg = load_one(&input)?;
             let hist = last_points(&seg.trajectory, history)?;
@@ -530,6 +579,7 @@ fn run(cli: Cli) -> Result<()> {
             stride,
             max_origins,
             segment,
+            limits,
             max_units,
             limit,
             split,
@@ -541,7 +591,8 @@ fn run(cli: Cli) -> Result<()> {
             quiet,
         } => {
             let bars = Bars::new(quiet)?;
-            let p = match protocol_name {
+            check_horizon(horizon)?;
+            let mut p = match protocol_name {
                 Some(name) => {
                     let p = protocol::preset(&name, seed.unwrap_or(protocol::DEFAULT_SEED), quick)?;
                     if let Some(d) = &ds
@@ -608,6 +659,7 @@ fn run(cli: Cli) -> Result<()> {
                     }
                 }
             };
+            p.load_options = limits.apply(p.load_options);
             // bad settings and misspelt methods fail before the (possibly long) loading
             p.validate()?;
             for m in &p.methods {
@@ -705,6 +757,7 @@ fn run(cli: Cli) -> Result<()> {
             origin,
             output,
         } => {
+            check_horizon(horizon)?;
             build(&method, &method_options(horizon))?;
             let seg = load_one(&input)?;
             let tr = &seg.trajectory;

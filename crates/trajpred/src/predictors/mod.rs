@@ -3,12 +3,14 @@
 mod gskf;
 mod hmm;
 mod kf_dynamic;
+mod kf_time;
 mod particle;
 mod poly;
 
 pub use gskf::{Gsc, Gskf, GskfParams};
 pub use hmm::{Hmm, HmmParams};
 pub use kf_dynamic::{Continuation, KfDynamic, KfDynamicParams, NaiveKf};
+pub use kf_time::{KfTime, KfTimeParams};
 pub use particle::{ParticleKind, ParticleParams, ParticlePredictor};
 pub use poly::{PolyFit, PolyFitParams};
 

@@ -1,0 +1,265 @@
+//! A Kalman filter over actual time, with its noise fitted to the data: constant velocity
+//! (or acceleration) driven by continuous white noise, whose `Q` follows each interval of the
+//! track, and the spectral density `q` and observation variance `r` chosen by maximum
+//! likelihood on the training tracks. Run through the filter driver
+//! ([`trajpred_kalman::driver`]); forecasts at any future times.
+
+use super::{invalid, positions_forecast};
+use nalgebra::{DMatrix, DVector, Dyn};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use trajpred_core::{
+    Error, Forecast, Gaussian, Predictor, Result, Trajectory, check_forecast_args,
+};
+use trajpred_kalman::driver::{TimeStepFilter, Timed, drive};
+use trajpred_kalman::motion::{
+    KinematicLayout, StateOrder, kinematic_continuous, position_observation,
+};
+use trajpred_kalman::{KalmanError, Kf, LinearObservation, LinearTransition};
+
+/// Settings of [`KfTime`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct KfTimeParams {
+    /// 2: constant velocity (white-noise acceleration); 3: constant acceleration (white-noise
+    /// jerk).
+    pub derivatives: usize,
+    /// Spectral density `q` of the white noise (m^2/s^3 for velocity, m^2/s^5 for
+    /// acceleration); replaced by the fitted value after [`Predictor::fit`] when `fit_noise`.
+    pub spectral_density: f64,
+    /// Observation variance `r` per axis (m^2); likewise fitted.
+    pub r: f64,
+    /// Variance of the initial velocity (and acceleration) components: vague, since the
+    /// filter starts from one position.
+    pub initial_rate_variance: f64,
+    /// Fit `spectral_density` and `r` by maximum likelihood on the training tracks.
+    pub fit_noise: bool,
+    /// The fit uses at most this many training tracks (evenly spread) ...
+    pub fit_tracks: usize,
+    /// ... and at most this many points of each.
+    pub fit_points: usize,
+}
+
+impl Default for KfTimeParams {
+    fn default() -> Self {
+        KfTimeParams {
+            derivatives: 2,
+            spectral_density: 1.0,
+            r: 10.0,
+            initial_rate_variance: 100.0,
+            fit_noise: true,
+            fit_tracks: 400,
+            fit_points: 200,
+        }
+    }
+}
+
+impl KfTimeParams {
+    fn validate(&self) -> Result<()> {
+        if !(2..=3).contains(&self.derivatives) {
+            return Err(invalid(
+                "derivatives",
+                format!(
+                    "must be 2 (velocity) or 3 (acceleration), got {}",
+                    self.derivatives
+                ),
+            ));
+        }
+        for (name, v) in [
+            ("spectral_density", self.spectral_density),
+            ("r", self.r),
+            ("initial_rate_variance", self.initial_rate_variance),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(invalid(
+                    name,
+                    format!("must be finite and positive, got {v}"),
+                ));
+            }
+        }
+        if self.fit_tracks == 0 || self.fit_points < 3 {
+            return Err(invalid(
+                "fit_tracks",
+                "the fit needs at least one track of at least 3 points",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The Kalman filter over actual time ("kf-cv", "kf-ca"): see the module documentation.
+///
+/// ```
+/// use trajpred::predictors::{KfTime, KfTimeParams};
+/// use trajpred_core::{Predictor, Trajectory};
+/// // 2 m/s along x, sampled at irregular times
+/// let t = vec![0.0, 1.0, 3.0, 3.5, 5.0, 8.0, 9.0];
+/// let x: Vec<f64> = t.iter().map(|t| 2.0 * t).collect();
+/// let tr = Trajectory::from_axes(t, vec![x, vec![0.0; 7]])?;
+/// let p = KfTime::new(KfTimeParams { fit_noise: false, ..Default::default() })?;
+/// // where at t = 10 s and t = 14 s?
+/// let f = p.forecast_times(&tr, &[10.0, 14.0])?;
+/// assert!((f.step(2)[0] - 28.0).abs() < 1.0);
+/// # Ok::<(), trajpred_core::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct KfTime {
+    params: KfTimeParams,
+}
+
+type DynKf = Kf<LinearTransition<f64, Dyn>, LinearObservation<f64, Dyn, Dyn>>;
+
+fn kalman(e: KalmanError) -> Error {
+    Error::method("kf-time", e)
+}
+
+impl KfTime {
+    /// A validated predictor.
+    pub fn new(params: KfTimeParams) -> Result<Self> {
+        params.validate()?;
+        Ok(KfTime { params })
+    }
+
+    /// The settings, with the fitted noise after [`Predictor::fit`].
+    pub fn params(&self) -> &KfTimeParams {
+        &self.params
+    }
+
+    fn layout(&self, axes: usize) -> Result<KinematicLayout> {
+        KinematicLayout::new(axes, self.params.derivatives, StateOrder::PositionsFirst)
+            .map_err(kalman)
+    }
+
+    /// The filter after running through `history` with noise `(q, r)`.
+    #[allow(clippy::type_complexity)]
+    fn run(
+        &self,
+        history: &Trajectory,
+        q: f64,
+        r: f64,
+    ) -> Result<Timed<f64, Dyn, DynKf, impl Fn(f64) -> trajpred_kalman::Result<DynKf>>> {
+        let d = history.dim();
+        let layout = self.layout(d)?;
+        let n = layout.state_dim();
+        let make = move |dt: f64| {
+            let tr = kinematic_continuous::<f64, Dyn>(layout, dt, q)?;
+            let obs = position_observation::<f64, Dyn, Dyn>(layout, r)?;
+            Kf::new(tr, obs)
+        };
+        let first = history.point(0);
+        let mut mean = DVector::zeros(n);
+        let mut var = DVector::from_element(n, self.params.initial_rate_variance);
+        for a in 0..d {
+            mean[a] = first[a];
+            var[a] = r;
+        }
+        let start = Gaussian::new(mean, DMatrix::from_diagonal(&var))?;
+        let mut f = Timed::new(make, start);
+        let z: Vec<Option<DVector<f64>>> = (0..history.len())
+            .map(|k| Some(DVector::from_column_slice(&history.point(k))))
+            .collect();
+        drive(&mut f, history.times(), &z, |_, _| Ok(())).map_err(kalman)?;
+        Ok(f)
+    }
+
+    /// The log-likelihood of the tracks under `(q, r)`, summed.
+    fn log_likelihood(&self, tracks: &[Trajectory], q: f64, r: f64) -> f64 {
+        tracks
+            .par_iter()
+            .map(|t| match self.run(t, q, r) {
+                Ok(f) => f.log_likelihood(),
+                Err(_) => f64::NEG_INFINITY,
+            })
+            .sum()
+    }
+}
+
+/// Maximises `f` over a box of `(log10 q, log10 r)`: a coarse grid, then three rounds of
+/// a finer grid around the best point.
+fn maximise(f: impl Fn(f64, f64) -> f64, q: (f64, f64), r: (f64, f64)) -> (f64, f64, f64) {
+    let mut best = (f64::NEG_INFINITY, q.0, r.0);
+    let (mut qs, mut rs) = ((q.1 - q.0) / 6.0, (r.1 - r.0) / 6.0);
+    let (mut qc, mut rc) = ((q.0 + q.1) / 2.0, (r.0 + r.1) / 2.0);
+    for _round in 0..4 {
+        for i in -3..=3 {
+            for j in -3..=3 {
+                let (lq, lr) = (qc + f64::from(i) * qs, rc + f64::from(j) * rs);
+                let v = f(10f64.powf(lq), 10f64.powf(lr));
+                if v > best.0 {
+                    best = (v, lq, lr);
+                }
+            }
+        }
+        (qc, rc) = (best.1, best.2);
+        qs /= 3.0;
+        rs /= 3.0;
+    }
+    (best.0, 10f64.powf(best.1), 10f64.powf(best.2))
+}
+
+impl Predictor for KfTime {
+    fn name(&self) -> &str {
+        if self.params.derivatives == 3 {
+            "kf-ca"
+        } else {
+            "kf-cv"
+        }
+    }
+
+    fn fit(&mut self, train: &[Trajectory]) -> Result<()> {
+        if !self.params.fit_noise {
+            return Ok(());
+        }
+        let usable: Vec<&Trajectory> = train.iter().filter(|t| t.len() >= 3).collect();
+        if usable.is_empty() {
+            return Err(Error::Empty {
+                what: "training tracks of at least 3 points (to fit the noise)",
+            });
+        }
+        let step = usable.len().div_ceil(self.params.fit_tracks).max(1);
+        let tracks: Vec<Trajectory> = usable
+            .iter()
+            .step_by(step)
+            .map(|t| t.slice(0..t.len().min(self.params.fit_points)))
+            .collect::<Result<_>>()?;
+        let (ll, q, r) = maximise(
+            |q, r| self.log_likelihood(&tracks, q, r),
+            (-4.0, 3.0),
+            (-2.0, 3.0),
+        );
+        if !ll.is_finite() {
+            return Err(Error::method(
+                self.name().to_string(),
+                KalmanError::InvalidParameter {
+                    name: "noise",
+                    reason: "no noise setting gives a finite likelihood on the training tracks"
+                        .into(),
+                },
+            ));
+        }
+        self.params.spectral_density = q;
+        self.params.r = r;
+        Ok(())
+    }
+
+    fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
+        check_forecast_args(history, horizon, 1)?;
+        let t = history.times();
+        let n = t.len();
+        let dt = if n >= 2 {
+            (t[n - 1] - t[0]) / (n - 1) as f64
+        } else {
+            1.0
+        };
+        let times: Vec<f64> = (1..=horizon).map(|k| t[n - 1] + dt * k as f64).collect();
+        self.forecast_times(history, &times)
+    }
+
+    fn forecast_times(&self, history: &Trajectory, times: &[f64]) -> Result<Forecast> {
+        check_forecast_args(history, times.len(), 1)?;
+        let last = history.times()[history.len() - 1];
+        let offsets: Vec<f64> = times.iter().map(|&t| t - last).collect();
+        let f = self.run(history, self.params.spectral_density, self.params.r)?;
+        let states = f.forecast_at(&offsets).map_err(kalman)?;
+        positions_forecast(&states, history.dim())
+    }
+}
