@@ -130,7 +130,16 @@ where
 {
     check_positive("dt", dt, false)?;
     check_positive("var", var, true)?;
-    kinematic_with(layout, dt, white_noise_block(layout.derivatives, dt, var))
+    kinematic_with(
+        layout,
+        polynomial_block(dt),
+        white_noise_block(layout.derivatives, dt, var),
+    )
+}
+
+/// The transition block of one axis: `[[1, dt, dt^2/2], [0, 1, dt], [0, 0, 1]]`.
+fn polynomial_block(dt: f64) -> [[f64; 3]; 3] {
+    [[1.0, dt, dt * dt / 2.0], [0.0, 1.0, dt], [0.0, 0.0, 1.0]]
 }
 
 /// The continuous white-noise block for one axis (filterpy's
@@ -185,14 +194,83 @@ where
     check_positive("spectral_density", spectral_density, true)?;
     kinematic_with(
         layout,
-        dt,
+        polynomial_block(dt),
         continuous_noise_block(layout.derivatives, dt, spectral_density),
+    )
+}
+
+/// Damped velocity (the integrated Ornstein-Uhlenbeck model): per axis the velocity relaxes
+/// towards zero with time constant `time_constant` seconds while a continuous white noise of
+/// density `spectral_density` drives it; the position integrates it. With `beta = 1 / tau`
+/// and `e = exp(-beta dt)`:
+///
+/// ```text
+/// F = [[1, (1 - e) / beta], [0, e]]
+/// Q = q [[(dt - 2 (1 - e) / beta + (1 - e^2) / (2 beta)) / beta^2, (1 - e)^2 / (2 beta^2)],
+///        [(1 - e)^2 / (2 beta^2),                                  (1 - e^2) / (2 beta)]]
+/// ```
+///
+/// (the position variance by its series
+/// `dt^3 (1/3 - beta dt/4 + 7 (beta dt)^2/60 - (beta dt)^3/24)` when `beta dt < 0.01`, where
+/// the closed form cancels). As `tau` grows it becomes
+/// [`kinematic_continuous`]'s constant velocity; a forecast's displacement is bounded by
+/// `v tau`, which suits targets that slow down and stop.
+///
+/// ```
+/// use nalgebra::U2;
+/// use trajpred_kalman::motion::{KinematicLayout, StateOrder, damped_velocity, kinematic_continuous};
+/// use trajpred_kalman::{LinearTransitionModel, Transition};
+/// let l = KinematicLayout::new(1, 2, StateOrder::AxisBlocks)?;
+/// let damped = damped_velocity::<f64, U2>(l, 2.0, 1.0, 1e9)?;
+/// let cv = kinematic_continuous::<f64, U2>(l, 2.0, 1.0)?;
+/// assert!((damped.f() - cv.f()).abs().max() < 1e-8);
+/// assert!((damped.process_noise() - cv.process_noise()).abs().max() < 1e-8);
+/// # Ok::<(), trajpred_kalman::KalmanError>(())
+/// ```
+pub fn damped_velocity<T, D>(
+    layout: KinematicLayout,
+    dt: f64,
+    spectral_density: f64,
+    time_constant: f64,
+) -> Result<LinearTransition<T, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    check_positive("dt", dt, false)?;
+    check_positive("spectral_density", spectral_density, true)?;
+    check_positive("time_constant", time_constant, false)?;
+    if layout.derivatives != 2 {
+        return Err(KalmanError::InvalidParameter {
+            name: "layout",
+            reason: format!(
+                "damped velocity has 2 derivatives per axis, got {}",
+                layout.derivatives
+            ),
+        });
+    }
+    let (q, beta) = (spectral_density, 1.0 / time_constant);
+    let bdt = beta * dt;
+    let one_minus_e = -(-bdt).exp_m1();
+    let e = 1.0 - one_minus_e;
+    let var_x = if bdt < 0.01 {
+        q * dt.powi(3) * (1.0 / 3.0 - bdt / 4.0 + 7.0 * bdt * bdt / 60.0 - bdt.powi(3) / 24.0)
+    } else {
+        q / (beta * beta) * (dt - 2.0 * one_minus_e / beta - (-2.0 * bdt).exp_m1() / (2.0 * beta))
+    };
+    let cov_xv = q * one_minus_e * one_minus_e / (2.0 * beta * beta);
+    let var_v = -q * (-2.0 * bdt).exp_m1() / (2.0 * beta);
+    kinematic_with(
+        layout,
+        [[1.0, one_minus_e / beta, 0.0], [0.0, e, 0.0], [0.0; 3]],
+        [[var_x, cov_xv, 0.0], [cov_xv, var_v, 0.0], [0.0; 3]],
     )
 }
 
 fn kinematic_with<T, D>(
     layout: KinematicLayout,
-    dt: f64,
+    f_block: [[f64; 3]; 3],
     q_block: [[f64; 3]; 3],
 ) -> Result<LinearTransition<T, D>>
 where
@@ -203,22 +281,13 @@ where
     let n = layout.state_dim();
     let d: D = state_dim_type(n)?;
     let k = layout.derivatives;
-    let block_f = |i: usize, j: usize| -> f64 {
-        // F block: [[1, dt, dt^2/2], [0, 1, dt], [0, 0, 1]]
-        if j < i {
-            0.0
-        } else {
-            let p = (j - i) as i32;
-            dt.powi(p) / if p == 2 { 2.0 } else { 1.0 }
-        }
-    };
     let mut f = OMatrix::<T, D, D>::zeros_generic(d, d);
     let mut q = OMatrix::<T, D, D>::zeros_generic(d, d);
     for axis in 0..layout.axes {
         for (i, q_row) in q_block.iter().enumerate().take(k) {
             for (j, &qv) in q_row.iter().enumerate().take(k) {
                 let (r, c) = (layout.index(axis, i), layout.index(axis, j));
-                f[(r, c)] = nalgebra::convert(block_f(i, j));
+                f[(r, c)] = nalgebra::convert(f_block[i][j]);
                 q[(r, c)] = nalgebra::convert(qv);
             }
         }

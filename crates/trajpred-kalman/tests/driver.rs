@@ -212,3 +212,62 @@ fn bad_time_steps_are_typed_errors() {
         Err(KalmanError::InvalidParameter { name: "dt", .. })
     ));
 }
+
+/// The damped-velocity (integrated Ornstein-Uhlenbeck) noise against its defining integrals,
+/// computed by Simpson's rule: with `g(s) = (1 - exp(-beta s)) / beta`,
+/// `Var x = q int_0^dt g^2`, `Cov(x, v) = q int_0^dt g e^{-beta s}`, `Var v = q int_0^dt e^{-2 beta s}`
+/// (tolerance 1e-9 relative: Simpson's rule with 20000 panels is exact to about 1e-15 here).
+#[test]
+fn damped_velocity_noise_matches_its_integrals() {
+    use trajpred_kalman::motion::damped_velocity;
+    let l = KinematicLayout::new(1, 2, StateOrder::AxisBlocks).expect("layout");
+    for (dt, tau, q) in [
+        (1.0, 5.0, 2.0),
+        (3.0, 2.0, 0.5),
+        (0.5, 100.0, 1.0),
+        (4.0, 0.7, 3.0),
+    ] {
+        let beta: f64 = 1.0 / tau;
+        let simpson = |f: &dyn Fn(f64) -> f64| {
+            let n = 20_000;
+            let h = dt / n as f64;
+            (0..=n)
+                .map(|i| {
+                    let w = if i == 0 || i == n {
+                        1.0
+                    } else if i % 2 == 1 {
+                        4.0
+                    } else {
+                        2.0
+                    };
+                    w * f(i as f64 * h)
+                })
+                .sum::<f64>()
+                * h
+                / 3.0
+        };
+        let g = |s: f64| (1.0 - (-beta * s).exp()) / beta;
+        let want = [
+            q * simpson(&|s| g(s) * g(s)),
+            q * simpson(&|s| g(s) * (-beta * s).exp()),
+            q * simpson(&|s| (-2.0 * beta * s).exp()),
+        ];
+        let tr = damped_velocity::<f64, nalgebra::U2>(l, dt, q, tau).expect("model");
+        let got = [
+            tr.process_noise()[(0, 0)],
+            tr.process_noise()[(0, 1)],
+            tr.process_noise()[(1, 1)],
+        ];
+        for (g, w) in got.iter().zip(want) {
+            assert!(
+                (g - w).abs() <= 1e-9 * w.abs(),
+                "dt {dt} tau {tau}: {got:?} vs {want:?}"
+            );
+        }
+        // F: the position moves by v tau (1 - e^{-dt/tau}); the velocity decays
+        let x = tr
+            .transition(&nalgebra::Vector2::new(0.0, 1.0))
+            .expect("transition");
+        assert!((x[0] - g(dt)).abs() < 1e-12 && (x[1] - (-beta * dt).exp()).abs() < 1e-15);
+    }
+}

@@ -127,7 +127,10 @@ fn bad_settings_and_inputs_are_typed_errors() {
     }
     let mut p = KfTime::new(KfTimeParams::default()).expect("params");
     let one = Trajectory::uniform(0.0, 1.0, vec![vec![1.0, 2.0]]).expect("track");
-    assert!(matches!(p.fit(std::slice::from_ref(&one)), Err(Error::Empty { .. })));
+    assert!(matches!(
+        p.fit(std::slice::from_ref(&one)),
+        Err(Error::Empty { .. })
+    ));
     // a requested time before the history's end is refused, not extrapolated backwards
     assert!(p.forecast_times(&one, &[0.5]).is_err());
 }

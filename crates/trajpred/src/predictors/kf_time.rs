@@ -13,7 +13,7 @@ use trajpred_core::{
 };
 use trajpred_kalman::driver::{TimeStepFilter, Timed, drive};
 use trajpred_kalman::motion::{
-    KinematicLayout, StateOrder, kinematic_continuous, position_observation,
+    KinematicLayout, StateOrder, damped_velocity, kinematic_continuous, position_observation,
 };
 use trajpred_kalman::{KalmanError, Kf, LinearObservation, LinearTransition};
 
@@ -31,6 +31,10 @@ pub struct KfTimeParams {
     /// Variance of the initial velocity (and acceleration) components: vague, since the
     /// filter starts from one position.
     pub initial_rate_variance: f64,
+    /// With 2 derivatives: the velocity relaxes towards zero with this time constant
+    /// (seconds; the integrated Ornstein-Uhlenbeck model of
+    /// [`trajpred_kalman::motion::damped_velocity`]); `None`: constant velocity.
+    pub time_constant: Option<f64>,
     /// Fit `spectral_density` and `r` by maximum likelihood on the training tracks.
     pub fit_noise: bool,
     /// The fit uses at most this many training tracks (evenly spread) ...
@@ -46,6 +50,7 @@ impl Default for KfTimeParams {
             spectral_density: 1.0,
             r: 10.0,
             initial_rate_variance: 100.0,
+            time_constant: None,
             fit_noise: true,
             fit_tracks: 400,
             fit_points: 200,
@@ -140,8 +145,12 @@ impl KfTime {
         let d = history.dim();
         let layout = self.layout(d)?;
         let n = layout.state_dim();
+        let tau = self.params.time_constant;
         let make = move |dt: f64| {
-            let tr = kinematic_continuous::<f64, Dyn>(layout, dt, q)?;
+            let tr = match tau {
+                Some(tau) => damped_velocity::<f64, Dyn>(layout, dt, q, tau)?,
+                None => kinematic_continuous::<f64, Dyn>(layout, dt, q)?,
+            };
             let obs = position_observation::<f64, Dyn, Dyn>(layout, r)?;
             Kf::new(tr, obs)
         };
