@@ -102,7 +102,7 @@ fn kf_dynamic_and_naive_kf_extrapolate_uniform_motion() {
     // The paper's literal multi-step rule re-applies eq. 13-15 with the LAST observation at
     // every step, which pulls steps 2.. back towards it: step 1 is right, later steps fall
     // short of the extrapolation (the pull is K (Z(k) - H X), towards the stale point).
-    let literal = KfDynamic::new(KfDynamicParams::paper_position(10.0)).unwrap();
+    let literal = KfDynamic::new(KfDynamicParams::paper_position_literal(10.0)).unwrap();
     let f = literal.forecast(&tr, 3).unwrap();
     assert!((f.step(1)[0] - 3.0 * n as f64).abs() < 0.5);
     let last = 3.0 * (n - 1) as f64;

@@ -645,7 +645,11 @@ fn run(cli: Cli) -> Result<()> {
                     .reports
                     .iter()
                     .zip(&run.fit_seconds)
-                    .map(|(r, &fit)| MethodReport {
+                    .zip(&run.labels)
+                    .map(|((r, &fit), label)| MethodReport {
+                        // the row is the method as asked for (`kf-dynamic-literal`, not the
+                        // predictor's own `kf-dynamic`)
+                        method: label.clone(),
                         fit_seconds: fit,
                         ..r[0].clone()
                     })
