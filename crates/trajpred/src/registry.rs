@@ -72,6 +72,10 @@ pub const METHODS: &[MethodInfo] = &[
         description: "naive KF with the 4-D position + velocity observation (R = I)",
     },
     MethodInfo {
+        name: "cv-time",
+        description: "last velocity (last two points over their time difference), on the history's mean interval",
+    },
+    MethodInfo {
         name: "poly1",
         description: "least-squares line through the last N points, extrapolated",
     },
@@ -185,6 +189,7 @@ pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
         "naive-kf-4d" => Box::new(NaiveKf::new(KfDynamicParams::paper_position_velocity(
             opts.kf_q,
         ))?),
+        "cv-time" => Box::new(CvTime::new()),
         "poly1" | "poly2" => Box::new(PolyFit::new(PolyFitParams {
             degree: if name == "poly1" { 1 } else { 2 },
             points: opts.poly_points,
