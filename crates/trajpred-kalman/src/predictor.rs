@@ -1,5 +1,5 @@
-//! The KF-dynamic predictor form of the dynamic trajectory prediction paper (SPEC B.1,
-//! eq. 13-15) and its multi-step forecast, as methods of [`Kf`].
+//! The KF-dynamic predictor form of the dynamic trajectory prediction paper (eq.
+//! 13-15) and its multi-step forecast, as methods of [`Kf`].
 //!
 //! ```text
 //! K(k)     = A P(k|k-1) H^T (H P(k|k-1) H^T + R)^-1                       (eq. 13)
@@ -22,15 +22,26 @@ use trajpred_core::Gaussian;
 
 /// How [`Kf::predictor_forecast`] continues after the first step, for which the latest
 /// observation is used.
+///
+/// The paper says to "use the previous moment's observation and iterate k steps" of eq.
+/// 13-15. Read literally ([`MultiStep::ReuseLastObservation`]), every later step corrects
+/// towards the same `Z(k)` again, as if the target were seen at that place once more, which
+/// pulls the forecast back to where the target was. [`MultiStep::Extrapolate`] (the
+/// default) uses `Z(k)` once and then predicts alone; its forecast equals the standard
+/// filter's `X(k|k)` extrapolated by `A`.
+///
+/// ```
+/// use trajpred_kalman::MultiStep;
+/// assert_eq!(MultiStep::default(), MultiStep::Extrapolate);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum MultiStep {
     /// Re-apply eq. 13-15 with the latest observation `Z(k)` at every step: the literal
-    /// reading of the paper ("use the previous moment's observation and iterate k steps").
-    /// The default.
-    #[default]
+    /// reading of the paper, kept for its reproduction.
     ReuseLastObservation,
     /// After the first step, extrapolate without correction: `X(k+j+1|k) = A X(k+j|k)`,
-    /// `P = A P A^T + Q`.
+    /// `P = A P A^T + Q`. The default.
+    #[default]
     Extrapolate,
 }
 

@@ -48,11 +48,20 @@ pub struct MethodInfo {
 pub const METHODS: &[MethodInfo] = &[
     MethodInfo {
         name: "kf-dynamic",
-        description: "KF-dynamic paper: predictor form of the Kalman filter (eq. 13-15), CV model",
+        description: "KF-dynamic paper: predictor form of the Kalman filter (eq. 13-15), CV model, \
+                      extrapolated after the first step",
     },
     MethodInfo {
         name: "kf-dynamic-4d",
         description: "KF dynamic with the 4-D position + velocity observation (R = I)",
+    },
+    MethodInfo {
+        name: "kf-dynamic-literal",
+        description: "KF dynamic as the paper reads literally: every step re-uses the last observation",
+    },
+    MethodInfo {
+        name: "kf-dynamic-4d-literal",
+        description: "kf-dynamic-literal with the 4-D position + velocity observation (R = I)",
     },
     MethodInfo {
         name: "naive-kf",
@@ -69,6 +78,10 @@ pub const METHODS: &[MethodInfo] = &[
     MethodInfo {
         name: "kf-ca",
         description: "Kalman filter over actual time: constant acceleration, continuous white-noise jerk, q and r fitted by maximum likelihood",
+    },
+    MethodInfo {
+        name: "cv-time",
+        description: "last velocity (last two points over their time difference), on the history's mean interval",
     },
     MethodInfo {
         name: "poly1",
@@ -174,6 +187,12 @@ pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
         "kf-dynamic-4d" => Box::new(KfDynamic::new(KfDynamicParams::paper_position_velocity(
             opts.kf_q,
         ))?),
+        "kf-dynamic-literal" => Box::new(KfDynamic::new(KfDynamicParams::paper_position_literal(
+            opts.kf_q,
+        ))?),
+        "kf-dynamic-4d-literal" => Box::new(KfDynamic::new(
+            KfDynamicParams::paper_position_velocity_literal(opts.kf_q),
+        )?),
         "naive-kf" => Box::new(NaiveKf::new(KfDynamicParams::paper_position(opts.kf_q))?),
         "naive-kf-4d" => Box::new(NaiveKf::new(KfDynamicParams::paper_position_velocity(
             opts.kf_q,
@@ -182,6 +201,7 @@ pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
             derivatives: if name == "kf-cv" { 2 } else { 3 },
             ..Default::default()
         })?),
+        "cv-time" => Box::new(CvTime::new()),
         "poly1" | "poly2" => Box::new(PolyFit::new(PolyFitParams {
             degree: if name == "poly1" { 1 } else { 2 },
             points: opts.poly_points,

@@ -102,7 +102,7 @@ fn kf_dynamic_and_naive_kf_extrapolate_uniform_motion() {
     // The paper's literal multi-step rule re-applies eq. 13-15 with the LAST observation at
     // every step, which pulls steps 2.. back towards it: step 1 is right, later steps fall
     // short of the extrapolation (the pull is K (Z(k) - H X), towards the stale point).
-    let literal = KfDynamic::new(KfDynamicParams::paper_position(10.0)).unwrap();
+    let literal = KfDynamic::new(KfDynamicParams::paper_position_literal(10.0)).unwrap();
     let f = literal.forecast(&tr, 3).unwrap();
     assert!((f.step(1)[0] - 3.0 * n as f64).abs() < 0.5);
     let last = 3.0 * (n - 1) as f64;
@@ -229,5 +229,96 @@ fn hmm_errors() {
             ..Default::default()
         }),
         Err(Error::InvalidParameter { name: "states", .. })
+    ));
+}
+
+/// `cv-time` worked by hand: times 0, 2, 3, 7 give the mean interval Δ = 7 / 3 s; the last
+/// leg goes from (2, 6) to (10, -2) in 4 s, so v = (2, -2) m/s and step k lands at
+/// (10 + 2 k Δ, -2 - 2 k Δ).
+#[test]
+fn cv_time_extrapolates_the_last_velocity_on_the_mean_interval() {
+    let times = vec![0.0, 2.0, 3.0, 7.0];
+    let tr = Trajectory::from_axes(
+        times.clone(),
+        vec![vec![-5.0, 0.0, 2.0, 10.0], vec![1.0, 3.0, 6.0, -2.0]],
+    )
+    .unwrap();
+    let p = CvTime::new();
+    assert_eq!(p.name(), "cv-time");
+    let f = p.forecast(&tr, 3).unwrap();
+    let expected = [
+        (10.0 + 14.0 / 3.0, -2.0 - 14.0 / 3.0),
+        (10.0 + 28.0 / 3.0, -2.0 - 28.0 / 3.0),
+        (24.0, -16.0),
+    ];
+    for (k, (ex, ey)) in expected.into_iter().enumerate() {
+        let s = f.step(k + 1);
+        assert!(
+            (s[0] - ex).abs() < 1e-12 && (s[1] - ey).abs() < 1e-12,
+            "{k}: {s:?}"
+        );
+    }
+    assert!(f.covariance(1).is_none());
+
+    // it depends only on the last two points and the mean interval: other earlier points
+    // and inner times (same first and last times, same length) give the same forecast
+    let other = Trajectory::from_axes(
+        vec![0.0, 0.5, 3.0, 7.0],
+        vec![vec![400.0, -30.0, 2.0, 10.0], vec![-9.0, 77.0, 6.0, -2.0]],
+    )
+    .unwrap();
+    assert_eq!(p.forecast(&other, 3).unwrap(), f);
+    // a different first time changes Δ only: t0 = -2 gives Δ = 3 s, step 1 at (16, -8)
+    let earlier = Trajectory::from_axes(
+        vec![-2.0, 2.0, 3.0, 7.0],
+        tr.axes().map(<[f64]>::to_vec).collect(),
+    )
+    .unwrap();
+    let g = p.forecast(&earlier, 1).unwrap();
+    assert!((g.step(1)[0] - 16.0).abs() < 1e-12 && (g.step(1)[1] + 8.0).abs() < 1e-12);
+    // a different last leg duration changes the velocity: t2 = 5 gives v = (4, -4), and
+    // Δ stays 7 / 3 s
+    let quicker = Trajectory::from_axes(
+        vec![0.0, 2.0, 5.0, 7.0],
+        tr.axes().map(<[f64]>::to_vec).collect(),
+    )
+    .unwrap();
+    let h = p.forecast(&quicker, 1).unwrap();
+    assert!((h.step(1)[0] - (10.0 + 28.0 / 3.0)).abs() < 1e-12);
+
+    // causal: forecasting from the 4-point prefix of a longer track ignores what follows
+    let longer = Trajectory::from_axes(
+        vec![0.0, 2.0, 3.0, 7.0, 8.0, 20.0],
+        vec![
+            vec![-5.0, 0.0, 2.0, 10.0, 1e4, -3.0],
+            vec![1.0, 3.0, 6.0, -2.0, 5.0, 8e3],
+        ],
+    )
+    .unwrap();
+    assert_eq!(p.forecast(&longer.prefix(4).unwrap(), 3).unwrap(), f);
+
+    // typed errors
+    assert!(matches!(
+        p.forecast(&tr, 0),
+        Err(Error::InvalidParameter {
+            name: "horizon",
+            ..
+        })
+    ));
+    assert!(matches!(
+        p.forecast(&tr.prefix(1).unwrap(), 1),
+        Err(Error::TooShort {
+            needed: 2,
+            got: 1,
+            ..
+        })
+    ));
+    let overflow = Trajectory::from_axes(vec![0.0, 1.0], vec![vec![-1e308, 1e308]]).unwrap();
+    assert!(matches!(
+        p.forecast(&overflow, 1),
+        Err(Error::NonFinite {
+            what: "forecast",
+            ..
+        })
     ));
 }

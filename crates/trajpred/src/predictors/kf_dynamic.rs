@@ -1,6 +1,6 @@
-//! The KF-dynamic paper's predictors (SPEC B.1): "KF dynamic" (the predictor form of eq.
-//! 13-15, iterated with the latest observation) and the "naive KF" (filter, then extrapolate
-//! `X(k+1) = A X(k)` without correction).
+//! The KF-dynamic paper's predictors: "KF dynamic" (the predictor form of eq. 13-15 through
+//! the history; see [`Continuation`] for its steps after the first) and the "naive KF"
+//! (filter, then extrapolate `X(k+1) = A X(k)` without correction).
 
 use super::{invalid, positions_forecast, step_interval};
 use nalgebra::{DMatrix, DVector, Dyn};
@@ -23,18 +23,39 @@ pub struct KfDynamicParams {
     pub observe_velocity: bool,
     /// Initial covariance `P(1|0) = p0 I`.
     pub p0: f64,
-    /// How "KF dynamic" continues after the first step (ignored by [`NaiveKf`]).
+    /// How "KF dynamic" continues after the first step (ignored by [`NaiveKf`]); the
+    /// presets [`Self::paper_position`] and [`Self::paper_position_velocity`] extrapolate,
+    /// the `_literal` ones re-use the last observation.
     pub multi_step: Continuation,
 }
 
 /// How "KF dynamic" continues after its first forecast step (mirrors
 /// [`trajpred_kalman::MultiStep`], with serde support).
+///
+/// The paper iterates eq. 13-15 k times "with the previous moment's observation". Read
+/// literally ([`Continuation::ReuseLastObservation`]), every later step is corrected towards
+/// the same last observation `Z(k)` again, which pulls steps 2.. back to where the target
+/// was; on real tracks that makes steps 2.. several times worse than the naive KF (see
+/// `docs/kf-dynamic.md`, "Multi-step forecast"). The default,
+/// [`Continuation::Extrapolate`], uses `Z(k)` for the first step only and then predicts
+/// alone: its forecast equals the naive KF's, `A^j X(k|k)`.
+///
+/// ```
+/// use trajpred::predictors::{Continuation, KfDynamicParams};
+/// assert_eq!(KfDynamicParams::default().multi_step, Continuation::Extrapolate);
+/// assert_eq!(
+///     KfDynamicParams::paper_position_literal(10.0).multi_step,
+///     Continuation::ReuseLastObservation
+/// );
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum Continuation {
-    /// Re-apply eq. 13-15 with the latest observation at every step (the paper's reading).
-    #[default]
+    /// Re-apply eq. 13-15 with the latest observation at every step: the paper's wording read
+    /// literally, kept for its reproduction (`kf-dynamic-literal` in the registry).
     ReuseLastObservation,
-    /// Extrapolate without correction after the first step.
+    /// Use the latest observation for the first step, then extrapolate without correction
+    /// (`X = A X`, `P = A P A^T + Q`). The default.
+    #[default]
     Extrapolate,
 }
 
@@ -55,23 +76,56 @@ impl Default for KfDynamicParams {
 
 impl KfDynamicParams {
     /// The paper's Table 1 with a position observation: `R = diag(10, 10)`, `Q = q I`
-    /// (q = 10 or 100).
+    /// (q = 10 or 100); extrapolates after the first step ([`Continuation::Extrapolate`]).
     pub fn paper_position(q: f64) -> Self {
         KfDynamicParams {
             q,
             r: 10.0,
             observe_velocity: false,
             p0: 100.0,
-            multi_step: Continuation::ReuseLastObservation,
+            multi_step: Continuation::Extrapolate,
         }
     }
 
-    /// The paper's Table 1 with a position + velocity observation: `R = I_4`, `Q = q I`.
+    /// The paper's Table 1 with a position + velocity observation: `R = I_4`, `Q = q I`;
+    /// extrapolates after the first step ([`Continuation::Extrapolate`]).
     pub fn paper_position_velocity(q: f64) -> Self {
         KfDynamicParams {
             r: 1.0,
             observe_velocity: true,
             ..Self::paper_position(q)
+        }
+    }
+
+    /// [`Self::paper_position`] with the paper's multi-step rule read literally
+    /// ([`Continuation::ReuseLastObservation`]), as the reproduction runs it.
+    ///
+    /// ```
+    /// use trajpred::predictors::{Continuation, KfDynamicParams};
+    /// let p = KfDynamicParams::paper_position_literal(100.0);
+    /// assert_eq!(p.multi_step, Continuation::ReuseLastObservation);
+    /// assert_eq!((p.q, p.r, p.observe_velocity), (100.0, 10.0, false));
+    /// ```
+    pub fn paper_position_literal(q: f64) -> Self {
+        KfDynamicParams {
+            multi_step: Continuation::ReuseLastObservation,
+            ..Self::paper_position(q)
+        }
+    }
+
+    /// [`Self::paper_position_velocity`] with the paper's multi-step rule read literally
+    /// ([`Continuation::ReuseLastObservation`]), as the reproduction runs it.
+    ///
+    /// ```
+    /// use trajpred::predictors::{Continuation, KfDynamicParams};
+    /// let p = KfDynamicParams::paper_position_velocity_literal(10.0);
+    /// assert_eq!(p.multi_step, Continuation::ReuseLastObservation);
+    /// assert_eq!((p.q, p.r, p.observe_velocity), (10.0, 1.0, true));
+    /// ```
+    pub fn paper_position_velocity_literal(q: f64) -> Self {
+        KfDynamicParams {
+            multi_step: Continuation::ReuseLastObservation,
+            ..Self::paper_position_velocity(q)
         }
     }
 
@@ -142,9 +196,11 @@ fn build(params: &KfDynamicParams, history: &Trajectory, method: &str) -> Result
     Ok(Setup { kf, z, initial })
 }
 
-/// "KF dynamic" (SPEC B.1, eq. 13-15): the one-step-ahead predictor form of the Kalman
-/// filter, run through the history, then iterated `horizon` steps with the latest
-/// observation. The forecast carries the position covariance of every step.
+/// "KF dynamic" (eq. 13-15): the one-step-ahead predictor form of the Kalman filter, run
+/// through the history; the first forecast step uses the latest observation, and the later
+/// ones follow [`KfDynamicParams::multi_step`] (by default prediction alone, which gives
+/// the naive KF's forecast; the paper's literal reading re-uses the latest observation at
+/// every step). The forecast carries the position covariance of every step.
 ///
 /// ```
 /// use trajpred::predictors::{KfDynamic, KfDynamicParams};
@@ -153,7 +209,11 @@ fn build(params: &KfDynamicParams, history: &Trajectory, method: &str) -> Result
 /// let tr = Trajectory::uniform(0.0, 1.0, vec![(0..30).map(|i| 2.0 * i as f64).collect(), vec![5.0; 30]])?;
 /// let f = KfDynamic::new(KfDynamicParams::paper_position(10.0))?.forecast(&tr, 3)?;
 /// assert!((f.step(1)[0] - 60.0).abs() < 1.0);
+/// assert!((f.step(3)[0] - 64.0).abs() < 1.0);
 /// assert!(f.covariance(1).is_some());
+/// // the literal reading falls behind from step 2 on: it is pulled back to x = 58
+/// let lit = KfDynamic::new(KfDynamicParams::paper_position_literal(10.0))?.forecast(&tr, 3)?;
+/// assert!(lit.step(3)[0] < 62.0);
 /// # Ok::<(), trajpred_core::Error>(())
 /// ```
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -1,5 +1,6 @@
 //! Every method of the four papers as a [`Predictor`](trajpred_core::Predictor).
 
+mod cv_time;
 mod gskf;
 mod hmm;
 mod kf_dynamic;
@@ -7,6 +8,7 @@ mod kf_time;
 mod particle;
 mod poly;
 
+pub use cv_time::CvTime;
 pub use gskf::{Gsc, Gskf, GskfParams};
 pub use hmm::{Hmm, HmmParams};
 pub use kf_dynamic::{Continuation, KfDynamic, KfDynamicParams, NaiveKf};
