@@ -228,10 +228,66 @@ fn kfu_same_seed_same_predictions_and_batched_equals_forecast() {
             assert!((x - y).abs() < 1e-5, "origin {i} axis {k}: {x} vs {y}");
         }
     }
-    // causal: changing points after the origin leaves the forecast unchanged
-    let f = a.forecast(&test.prefix(25).unwrap(), 3).unwrap();
-    let g = a.forecast(&noisy(25, 1.0), 3).unwrap();
-    assert_eq!(f, g);
+}
+
+/// `tr` with every point after `origin` changed: each coordinate moved by 100 to 200 (the
+/// curves span about 2), each timestamp delayed by 0.03 to 0.07 s (samples are 0.1 s apart).
+fn change_after(tr: &Trajectory, origin: usize) -> Trajectory {
+    let mut times = tr.times().to_vec();
+    let mut axes: Vec<Vec<f64>> = tr.axes().map(<[f64]>::to_vec).collect();
+    for i in origin + 1..tr.len() {
+        times[i] += 0.03 + 0.04 * ((i % 5) as f64 / 4.0);
+        for (k, a) in axes.iter_mut().enumerate() {
+            let sign = if (i + k) % 2 == 0 { 1.0 } else { -1.0 };
+            a[i] += sign * (100.0 + (i % 101) as f64);
+        }
+    }
+    Trajectory::from_axes(times, axes).unwrap()
+}
+
+/// Whether the prediction at some origin changes when every point after it changes;
+/// `route` gets the whole trajectory and an origin.
+fn leaks(
+    route: &dyn Fn(&Trajectory, usize) -> Vec<f64>,
+    tr: &Trajectory,
+    origins: &[usize],
+) -> bool {
+    origins
+        .iter()
+        .any(|&o| route(tr, o) != route(&change_after(tr, o), o))
+}
+
+#[test]
+fn kfu_is_causal_through_forecast_and_the_batched_pass() {
+    let mut m = small(9, 2);
+    m.fit(&[noisy(60, 0.0)]).unwrap();
+    let tr = noisy(40, 1.0);
+    // the context is 20 points: origins before it (one filter from point 0), at its edge
+    // and after it (batched windows), up to the last but one point
+    let origins = [0, 5, 18, 19, 20, 25, 38];
+    // the batched pass is handed the whole trajectory: entry o is the prediction from
+    // points 0..=o, and every earlier entry must not move either
+    let batched =
+        |tr: &Trajectory, o: usize| -> Vec<f64> { m.one_step_ahead(tr).unwrap()[..=o].concat() };
+    assert!(!leaks(&batched, &tr, &origins), "one_step_ahead");
+    let prefix = |tr: &Trajectory, o: usize| -> Vec<f64> {
+        let f = m.forecast(&tr.prefix(o + 1).unwrap(), 3).unwrap();
+        f.points().flat_map(|p| p.to_vec()).collect()
+    };
+    assert!(!leaks(&prefix, &tr, &origins), "forecast");
+    // the check has power: reading one entry (one point) too far is caught on either route
+    let one_too_far = |tr: &Trajectory, o: usize| m.one_step_ahead(tr).unwrap()[o + 1].clone();
+    assert!(leaks(&one_too_far, &tr, &origins[..6]));
+    let one_too_many = |tr: &Trajectory, o: usize| -> Vec<f64> {
+        let f = m.forecast(&tr.prefix(o + 2).unwrap(), 3).unwrap();
+        f.points().flat_map(|p| p.to_vec()).collect()
+    };
+    assert!(leaks(&one_too_many, &tr, &origins));
+    // and the predictions do depend on the past
+    let moved = change_after(&tr, 0);
+    for o in &origins[1..] {
+        assert_ne!(prefix(&tr, *o), prefix(&moved, *o), "origin {o}");
+    }
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! Behaviour of the trained models: the loss falls, runs are reproducible, forecasts are
-//! causal, models save and load, bad input gives typed errors.
+//! causal (and the causality check catches a leak), models save and load, bad input gives typed errors.
 
-use trajpred_core::{Predictor, Trajectory};
+use trajpred_core::{Forecast, Predictor, Trajectory};
 use trajpred_neural::{
     AxisMode, EarlyStopping, LstmArch, LstmNet, Mlp, MlpArch, NeuralError, RecurrentLayers,
     RnnArch, RnnNet, TrainConfig, TrainReport, WindowConfig, WindowNet,
@@ -120,8 +120,122 @@ fn same_seed_same_predictions() {
     assert_ne!(a, c, "another seed gives other weights");
 }
 
+/// `tr` with every point after `origin` changed: each coordinate moved by 100 to 200 (the
+/// curves span about 2), each timestamp delayed by 0.03 to 0.07 s (samples are 0.1 s apart,
+/// so times still increase).
+fn change_after(tr: &Trajectory, origin: usize) -> Trajectory {
+    let mut times = tr.times().to_vec();
+    let mut axes: Vec<Vec<f64>> = tr.axes().map(<[f64]>::to_vec).collect();
+    for i in origin + 1..tr.len() {
+        times[i] += 0.03 + 0.04 * ((i % 5) as f64 / 4.0);
+        for (k, a) in axes.iter_mut().enumerate() {
+            let sign = if (i + k) % 2 == 0 { 1.0 } else { -1.0 };
+            a[i] += sign * (100.0 + (i % 101) as f64);
+        }
+    }
+    Trajectory::from_axes(times, axes).unwrap()
+}
+
+/// A forecasting route: the forecast at `origin`, given the whole trajectory.
+type Route<'a> = dyn Fn(&Trajectory, usize) -> Forecast + 'a;
+
+/// Whether the forecast at some origin changes when every point after it changes.
+fn leaks(route: &Route, tr: &Trajectory, origins: &[usize]) -> bool {
+    origins
+        .iter()
+        .any(|&o| route(tr, o) != route(&change_after(tr, o), o))
+}
+
+/// A leaky predictor: it holds the trajectory it is evaluated on and returns the points
+/// that follow its history's last timestamp there.
+struct Peeker {
+    full: Trajectory,
+}
+
+impl Predictor for Peeker {
+    fn name(&self) -> &str {
+        "peeker"
+    }
+    fn fit(&mut self, _train: &[Trajectory]) -> trajpred_core::Result<()> {
+        Ok(())
+    }
+    fn forecast(&self, history: &Trajectory, horizon: usize) -> trajpred_core::Result<Forecast> {
+        let t = history.times().last().unwrap();
+        let i = self.full.times().iter().position(|s| s == t).unwrap();
+        let last = self.full.len() - 1;
+        let steps: Vec<_> = (1..=horizon)
+            .map(|k| self.full.point((i + k).min(last)))
+            .collect();
+        Forecast::new(history.dim(), steps)
+    }
+}
+
 #[test]
-fn forecast_is_causal_and_beyond_horizon_recursive() {
+fn forecasts_are_causal_and_the_check_catches_leaks() {
+    let cfg = || TrainConfig::new(1e-2).with_epochs(2).with_seed(2);
+    let mut mlp = Mlp::new(
+        MlpArch {
+            hidden: vec![8],
+            ..MlpArch::default()
+        },
+        layout(AxisMode::Joint),
+        cfg(),
+    )
+    .unwrap();
+    let mut per_axis = Mlp::new(
+        MlpArch {
+            hidden: vec![8],
+            ..MlpArch::default()
+        },
+        layout(AxisMode::PerAxis),
+        cfg(),
+    )
+    .unwrap();
+    let mut rnn = RnnNet::new(RnnArch(small_rec()), layout(AxisMode::Joint), cfg()).unwrap();
+    let mut lstm = LstmNet::new(LstmArch(small_rec()), layout(AxisMode::PerAxis), cfg()).unwrap();
+    let train = [curve(50, 0.0)];
+    mlp.fit(&train).unwrap();
+    per_axis.fit(&train).unwrap();
+    rnn.fit(&train).unwrap();
+    lstm.fit(&train).unwrap();
+    let models: [(&str, &dyn Predictor); 4] = [
+        ("mlp", &mlp),
+        ("mlp per axis", &per_axis),
+        ("rnn", &rnn),
+        ("lstm", &lstm),
+    ];
+    let tr = curve(40, 0.3);
+    // the first origin with a full window, one in the middle, the last but one point
+    let origins = [4, 20, 38];
+    for (name, m) in models {
+        // horizon 5 > trained T = 2: the recursive part is covered too
+        let prefix = |tr: &Trajectory, o: usize| m.forecast(&tr.prefix(o + 1).unwrap(), 5).unwrap();
+        assert!(!leaks(&prefix, &tr, &origins), "{name}");
+        // the check has power on this model: a history one point too long is caught
+        let one_too_many =
+            |tr: &Trajectory, o: usize| m.forecast(&tr.prefix(o + 2).unwrap(), 5).unwrap();
+        assert!(
+            leaks(&one_too_many, &tr, &origins),
+            "{name}: leak unnoticed"
+        );
+        // and the forecast does depend on the past
+        let moved = change_after(&tr, 0);
+        for o in origins {
+            assert_ne!(prefix(&tr, o), prefix(&moved, o), "{name} at origin {o}");
+        }
+    }
+    // a predictor holding the trajectory it is evaluated on is caught
+    let peek = |tr: &Trajectory, o: usize| {
+        Peeker { full: tr.clone() }
+            .forecast(&tr.prefix(o + 1).unwrap(), 5)
+            .unwrap()
+    };
+    assert!(leaks(&peek, &tr, &origins));
+    assert_eq!(peek(&tr, 20).step(1), &tr.point(21)[..]);
+}
+
+#[test]
+fn beyond_the_trained_horizon_forecasts_are_recursive() {
     let mut m = Mlp::new(
         MlpArch {
             hidden: vec![8],
@@ -132,22 +246,20 @@ fn forecast_is_causal_and_beyond_horizon_recursive() {
     )
     .unwrap();
     m.fit(&[curve(50, 0.0)]).unwrap();
-    let long = curve(40, 0.0);
-    let f1 = m.forecast(&long.prefix(30).unwrap(), 5).unwrap();
-    // changing every point after the origin does not change the forecast
-    let mut axes: Vec<Vec<f64>> = long.axes().map(<[f64]>::to_vec).collect();
-    for a in &mut axes {
-        for v in &mut a[30..] {
-            *v += 100.0;
-        }
-    }
-    let changed = Trajectory::uniform(0.0, 0.1, axes).unwrap();
-    let f2 = m.forecast(&changed.prefix(30).unwrap(), 5).unwrap();
-    assert_eq!(f1, f2);
-    // horizon 5 > trained T = 2: the first two steps equal the direct output
-    let direct = m.forecast(&long.prefix(30).unwrap(), 2).unwrap();
-    assert_eq!(f1.step(1), direct.step(1));
-    assert_eq!(f1.step(2), direct.step(2));
+    let h = curve(30, 0.0);
+    let f = m.forecast(&h, 5).unwrap();
+    // horizon 5 > trained T = 2: the first two steps equal the direct output ...
+    let direct = m.forecast(&h, 2).unwrap();
+    assert_eq!(f.step(1), direct.step(1));
+    assert_eq!(f.step(2), direct.step(2));
+    // ... and steps 3 and 4 are the direct output on the window moved by the first two
+    let mut w: Vec<Vec<f64>> = (25..30).map(|i| h.point(i).to_vec()).collect();
+    w.drain(..2);
+    w.push(f.step(1).to_vec());
+    w.push(f.step(2).to_vec());
+    let next = m.predict_window(&w).unwrap();
+    assert_eq!(f.step(3), &next[0][..]);
+    assert_eq!(f.step(4), &next[1][..]);
 }
 
 #[test]

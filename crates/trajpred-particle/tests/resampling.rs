@@ -69,9 +69,12 @@ fn indices_match_the_textbook_reference_for_given_uniforms() {
     }
 }
 
-/// filterpy 2.0.0 gives the same systematic, stratified and multinomial indices on normalised
-/// weights; its systematic resampler raises IndexError at the edge offset where ours
-/// returns valid indices; its residual resampler differs (biased, filterpy #290).
+/// Our functions against filterpy 2.0.0's answers for the same uniforms (recorded in the
+/// fixture by its script): the same systematic, stratified and multinomial indices on
+/// normalised weights; at the edge offset filterpy raises IndexError where ours returns valid
+/// indices; for residual resampling the deterministic copies agree and the remainder draws
+/// differ, since filterpy draws them from the biased residuals `w_i - floor(N w_i)` (filterpy
+/// #290). Exact equality: an index either matches or it does not.
 #[test]
 fn agrees_with_filterpy_where_filterpy_is_right() {
     let fx = fixture();
@@ -81,28 +84,85 @@ fn agrees_with_filterpy_where_filterpy_is_right() {
         if name == "unnormalised50" {
             continue; // filterpy assumes normalised weights
         }
+        let w = floats(&case["weights"]);
+        let n = w.len();
+        let mut out = vec![usize::MAX; n];
         if name == "edge_offset" {
             assert_eq!(case["filterpy_systematic"].as_str(), Some("IndexError"));
-            let w = floats(&case["weights"]);
-            let mut out = vec![usize::MAX; w.len()];
             systematic_indices(&w, case["offset"].as_f64().expect("u"), &mut out)
                 .expect("no crash at the edge");
-            assert!(out.iter().all(|&i| i < w.len()));
-            assert_eq!(out[w.len() - 1], w.len() - 1);
+            assert!(out.iter().all(|&i| i < n));
+            assert_eq!(out[n - 1], n - 1);
             continue;
         }
-        for scheme in ["systematic", "stratified", "multinomial"] {
-            assert_eq!(
-                indices(&case[format!("filterpy_{scheme}")]),
-                indices(&case[scheme]),
-                "{scheme}, {name}"
+        systematic_indices(&w, case["offset"].as_f64().expect("offset"), &mut out)
+            .expect("systematic");
+        assert_eq!(
+            out,
+            indices(&case["filterpy_systematic"]),
+            "systematic, {name}"
+        );
+        stratified_indices(&w, &floats(&case["stratified_uniforms"]), &mut out)
+            .expect("stratified");
+        assert_eq!(
+            out,
+            indices(&case["filterpy_stratified"]),
+            "stratified, {name}"
+        );
+        multinomial_indices(&w, &floats(&case["multinomial_uniforms"]), &mut out)
+            .expect("multinomial");
+        assert_eq!(
+            out,
+            indices(&case["filterpy_multinomial"]),
+            "multinomial, {name}"
+        );
+
+        let k =
+            residual_indices(&w, &floats(&case["residual_uniforms"]), &mut out).expect("residual");
+        let theirs = indices(&case["filterpy_residual"]);
+        // k = sum of floor(N w_i), worked here; filterpy places the same copies first
+        let copies: Vec<usize> = w
+            .iter()
+            .map(|&wi| (n as f64 * wi).floor() as usize)
+            .collect();
+        assert_eq!(k, copies.iter().sum::<usize>(), "copies, {name}");
+        assert_eq!(out[..k], theirs[..k], "deterministic copies, {name}");
+        for (i, &c) in copies.iter().enumerate() {
+            assert!(
+                out.iter().filter(|&&j| j == i).count() >= c,
+                "{name}: copies of {i}"
             );
         }
-        if case["filterpy_residual"] != case["residual"] {
+        if out[k..] != theirs[k..] {
             residual_differs += 1;
         }
     }
     assert!(residual_differs >= 3, "filterpy's residual bias visible");
+}
+
+/// Small cases worked by hand.
+#[test]
+fn hand_worked_systematic_and_residual() {
+    let mut out = [usize::MAX; 4];
+    // w = [0.1, 0.2, 0.3, 0.4], u = 0.5: positions 0.125, 0.375, 0.625, 0.875 against the
+    // cumulative sums 0.1, 0.3, 0.6, 1.0 fall in particles 1, 2, 3, 3
+    systematic_indices(&[0.1, 0.2, 0.3, 0.4], 0.5, &mut out).expect("systematic");
+    assert_eq!(out, [1, 2, 3, 3]);
+    // u = 0: positions 0, 0.25, 0.5, 0.75 fall in particles 0, 1, 2, 3
+    systematic_indices(&[0.1, 0.2, 0.3, 0.4], 0.0, &mut out).expect("systematic");
+    assert_eq!(out, [0, 1, 2, 3]);
+    // residual, w = [0.375, 0.375, 0.125, 0.125]: N w = [1.5, 1.5, 0.5, 0.5], so one copy
+    // each of 0 and 1 (k = 2) and two draws from the residuals [0.5, 0.5, 0.5, 0.5] / 2
+    // (cumulative 0.25, 0.5, 0.75, 1): u = 0.1 -> 0, u = 0.6 -> 2
+    let k =
+        residual_indices(&[0.375, 0.375, 0.125, 0.125], &[0.1, 0.6], &mut out).expect("residual");
+    assert_eq!((k, out), (2, [0, 1, 0, 2]));
+    // filterpy's biased residuals w - floor(N w) = [0.375, 0.375, 0.125, 0.125] (cumulative
+    // 0.375, 0.75, 0.875, 1) would give 0 and 1 for these draws instead
+    // a remainder of zero: N w = [2, 1, 1] exactly, no draw needed
+    let mut out = [usize::MAX; 4];
+    let k = residual_indices(&[0.5, 0.25, 0.25], &[], &mut out).expect("residual");
+    assert_eq!((k, out), (4, [0, 0, 1, 2]));
 }
 
 #[test]
