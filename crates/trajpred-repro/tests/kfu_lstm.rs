@@ -20,7 +20,14 @@ struct Run {
 
 fn data_dir() -> Option<PathBuf> {
     let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
-    d.join("adsb-traffic").is_dir().then_some(d)
+    let found = d.join("adsb-traffic").is_dir();
+    if !found {
+        eprintln!(
+            "skipped: the real-data parts of this test need ADS-B flights at {} (see docs/data.md)",
+            d.join("adsb-traffic").display()
+        );
+    }
+    found.then_some(d)
 }
 
 fn quick_run(data_dir: Option<PathBuf>) -> Run {

@@ -11,7 +11,14 @@ use trajpred_repro::{Context, Paper, Value, reproduce_into, run_paper};
 
 fn data_dir() -> Option<PathBuf> {
     let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
-    d.join("adsb-traffic").is_dir().then_some(d)
+    let found = d.join("adsb-traffic").is_dir();
+    if !found {
+        eprintln!(
+            "skipped: the real-data parts of this test need ADS-B flights at {} (see docs/data.md)",
+            d.join("adsb-traffic").display()
+        );
+    }
+    found.then_some(d)
 }
 
 fn quick(data_dir: Option<PathBuf>) -> Context {
