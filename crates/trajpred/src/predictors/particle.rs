@@ -9,9 +9,11 @@ use serde::{Deserialize, Serialize};
 use trajpred_core::{
     Error, Forecast, Gaussian, Predictor, Result, Trajectory, check_forecast_args,
 };
-use trajpred_kalman::motion::{StateOrder, constant_velocity};
-use trajpred_kalman::{LinearObservation, LinearTransition, MerweSigmaPoints};
-use trajpred_particle::{Mkpf, ParticleFilter, ParticleFiltering};
+use trajpred_kalman::driver::{TimeStepFilter, drive};
+use trajpred_kalman::motion::{KinematicLayout, StateOrder, kinematic_continuous};
+use trajpred_kalman::{LinearObservation, MerweSigmaPoints};
+use trajpred_particle::driver::TimedParticles;
+use trajpred_particle::{Mkpf, ParticleFilter};
 
 /// Which particle filter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -29,8 +31,10 @@ pub struct ParticleParams {
     pub kind: ParticleKind,
     /// Number of particles.
     pub particles: usize,
-    /// White-noise acceleration variance of the constant-velocity model (m^2/s^4).
-    pub accel_var: f64,
+    /// Spectral density of the continuous white-noise acceleration of the constant-velocity
+    /// model (m^2/s^3): `Q` follows each interval of the track
+    /// ([`trajpred_kalman::motion::kinematic_continuous`]).
+    pub accel_density: f64,
     /// Observation noise variance per axis (m^2).
     pub obs_var: f64,
     /// Initial covariance `p0 I` around `[z_0, 0]`.
@@ -49,7 +53,7 @@ impl ParticleParams {
                 ParticleKind::Bootstrap => 500,
                 ParticleKind::Mkpf => 50,
             },
-            accel_var: 1.0,
+            accel_density: 1.0,
             obs_var: 10.0,
             p0: 100.0,
             seed: 0,
@@ -57,11 +61,14 @@ impl ParticleParams {
     }
 }
 
-/// A particle filter run through the history, then its particle cloud pushed `horizon` steps
-/// ahead; the forecast is the cloud's mean and covariance of the positions.
+/// A particle filter run through the history at its actual times (the filter driver,
+/// [`trajpred_particle::driver::TimedParticles`]), then asked for the positions at the
+/// forecast times: the mean of the particles moved there without noise, and their spread plus
+/// that interval's `Q`.
 ///
-/// The CV process noise is the discrete white-noise `Q` plus `1e-6 accel_var I`, so that `Q`
-/// is positive definite (the MKPF's transition density needs it).
+/// The process noise is the continuous white-noise acceleration model, so `Q` is positive
+/// definite for every interval (the MKPF's transition density needs it) and grows with the
+/// interval: a 300 s T-Drive step gets the noise of 300 s, not of one step.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ParticlePredictor {
     params: ParticleParams,
@@ -74,7 +81,7 @@ impl ParticlePredictor {
             return Err(invalid("particles", "need at least one particle"));
         }
         for (name, v) in [
-            ("accel_var", params.accel_var),
+            ("accel_density", params.accel_density),
             ("obs_var", params.obs_var),
             ("p0", params.p0),
         ] {
@@ -87,34 +94,29 @@ impl ParticlePredictor {
         }
         Ok(ParticlePredictor { params })
     }
-}
 
-fn particle_error(method: &'static str) -> impl Fn(trajpred_particle::ParticleError) -> Error {
-    move |e| Error::method(method, e)
-}
-
-/// Filters `z` with a freshly built particle filter, then forecasts `horizon` steps.
-fn run<F: ParticleFiltering<f64, Dyn, Dyn>>(
-    filter: trajpred_particle::Result<F>,
-    z: &[Option<DVector<f64>>],
-    horizon: usize,
-    rng: &mut ChaCha8Rng,
-) -> trajpred_particle::Result<Vec<Gaussian<f64, Dyn>>> {
-    let mut pf = filter?;
-    pf.filter(z, rng)?;
-    pf.forecast(horizon, rng)
-}
-
-fn kalman_error(method: &'static str) -> impl Fn(trajpred_kalman::KalmanError) -> Error {
-    move |e| Error::method(method, e)
-}
-
-impl Predictor for ParticlePredictor {
-    fn name(&self) -> &str {
+    fn method(&self) -> &'static str {
         match self.params.kind {
             ParticleKind::Bootstrap => "pf",
             ParticleKind::Mkpf => "mkpf",
         }
+    }
+}
+
+/// Runs a filter through the history by the driver, then forecasts at `offsets`.
+fn run<F: TimeStepFilter<f64, Dyn, Dyn>>(
+    filter: &mut F,
+    times: &[f64],
+    z: &[Option<DVector<f64>>],
+    offsets: &[f64],
+) -> std::result::Result<Vec<Gaussian<f64, Dyn>>, F::Error> {
+    drive(filter, times, z, |_, _| Ok(()))?;
+    filter.forecast_at(offsets)
+}
+
+impl Predictor for ParticlePredictor {
+    fn name(&self) -> &str {
+        self.method()
     }
 
     fn fit(&mut self, _train: &[Trajectory]) -> Result<()> {
@@ -123,21 +125,26 @@ impl Predictor for ParticlePredictor {
 
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
         check_forecast_args(history, horizon, self.min_history())?;
-        let method = match self.params.kind {
-            ParticleKind::Bootstrap => "pf",
-            ParticleKind::Mkpf => "mkpf",
-        };
+        let dt = step_interval(history, history.len());
+        let last = history.times()[history.len() - 1];
+        let times: Vec<f64> = (1..=horizon).map(|k| last + dt * k as f64).collect();
+        self.forecast_times(history, &times)
+    }
+
+    fn forecast_times(&self, history: &Trajectory, times: &[f64]) -> Result<Forecast> {
+        check_forecast_args(history, times.len(), self.min_history())?;
+        let method = self.method();
+        let kalman = |e: trajpred_kalman::KalmanError| Error::method(method, e);
+        let particle = |e: trajpred_particle::ParticleError| Error::method(method, e);
         let p = &self.params;
         let d = history.dim();
         let n = 2 * d;
-        let dt = step_interval(history, history.len());
-        let cv = constant_velocity::<f64, Dyn>(d, dt, p.accel_var, StateOrder::PositionsFirst)
-            .map_err(kalman_error(method))?;
-        let q = cv.q() + DMatrix::identity(n, n) * (1e-6 * p.accel_var);
-        let transition = LinearTransition::new(cv.f().clone(), q).map_err(kalman_error(method))?;
+        let layout = KinematicLayout::new(d, 2, StateOrder::PositionsFirst).map_err(kalman)?;
+        let density = p.accel_density;
+        let make = move |dt: f64| kinematic_continuous::<f64, Dyn>(layout, dt, density);
         let h = DMatrix::from_fn(d, n, |i, j| if i == j { 1.0 } else { 0.0 });
-        let observation = LinearObservation::new(h, DMatrix::identity(d, d) * p.obs_var)
-            .map_err(kalman_error(method))?;
+        let observation =
+            LinearObservation::new(h, DMatrix::identity(d, d) * p.obs_var).map_err(kalman)?;
         let z: Vec<Option<DVector<f64>>> = history
             .points()
             .map(|pt| Some(DVector::from_column_slice(&pt)))
@@ -147,35 +154,47 @@ impl Predictor for ParticlePredictor {
             x0[a] = history.axis(a)[0];
         }
         let initial = Gaussian::new(x0, DMatrix::identity(n, n) * p.p0)?;
+        let t = history.times();
+        let last = t[t.len() - 1];
+        let offsets: Vec<f64> = times.iter().map(|&x| x - last).collect();
+        let first_dt = t[1] - t[0];
         let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
         let states = match p.kind {
-            ParticleKind::Bootstrap => run(
-                ParticleFilter::from_gaussian(
-                    transition,
+            ParticleKind::Bootstrap => {
+                let pf = ParticleFilter::from_gaussian(
+                    make(first_dt).map_err(kalman)?,
                     observation,
                     &initial,
                     p.particles,
                     &mut rng,
-                ),
-                &z[1..],
-                horizon,
-                &mut rng,
-            ),
-            ParticleKind::Mkpf => run(
-                Mkpf::from_gaussian(
-                    transition,
+                )
+                .map_err(particle)?;
+                run(
+                    &mut TimedParticles::new(make, pf, first_dt, rng),
+                    t,
+                    &z,
+                    &offsets,
+                )
+            }
+            ParticleKind::Mkpf => {
+                let mkpf = Mkpf::from_gaussian(
+                    make(first_dt).map_err(kalman)?,
                     observation,
                     &initial,
                     p.particles,
                     MerweSigmaPoints::default(),
                     &mut rng,
-                ),
-                &z[1..],
-                horizon,
-                &mut rng,
-            ),
+                )
+                .map_err(particle)?;
+                run(
+                    &mut TimedParticles::new(make, mkpf, first_dt, rng),
+                    t,
+                    &z,
+                    &offsets,
+                )
+            }
         }
-        .map_err(particle_error(method))?;
+        .map_err(particle)?;
         positions_forecast(&states, d)
     }
 
