@@ -165,16 +165,40 @@ where
     Ok(())
 }
 
-/// Writes `chart` to `path`: SVG for `.svg`, PNG for `.png` (800 x 600).
+/// Writes `chart` to `path`: SVG for `.svg`, PNG for `.png` (800 x 600). The chart is drawn
+/// into a temporary file in the same folder, then renamed over `path`, so an interrupted
+/// write leaves the old file (or none), never a torn one.
 pub fn write_chart(chart: &Chart, path: &Path) -> Result<()> {
     register_font();
     let size = (800, 600);
-    match path.extension().and_then(|e| e.to_str()) {
-        Some("svg") => draw(SVGBackend::new(path, size).into_drawing_area(), chart),
-        Some("png") => draw(BitMapBackend::new(path, size).into_drawing_area(), chart),
-        _ => Err(Error::InvalidParameter {
+    let ext = path.extension().and_then(|e| e.to_str());
+    if !matches!(ext, Some("svg") | Some("png")) {
+        return Err(Error::InvalidParameter {
             name: "output",
             reason: format!("{}: the file name must end in .svg or .png", path.display()),
-        }),
+        });
     }
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = path.with_file_name(format!(
+        ".{name}.tmp-{}.{}",
+        std::process::id(),
+        ext.unwrap_or("svg")
+    ));
+    let drawn = match ext {
+        Some("svg") => draw(SVGBackend::new(&tmp, size).into_drawing_area(), chart),
+        _ => draw(BitMapBackend::new(&tmp, size).into_drawing_area(), chart),
+    };
+    let renamed = drawn.and_then(|()| {
+        std::fs::rename(&tmp, path).map_err(|e| Error::InvalidParameter {
+            name: "output",
+            reason: format!("cannot write {}: {e}", path.display()),
+        })
+    });
+    if renamed.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    renamed
 }

@@ -452,3 +452,44 @@ fn a_huge_horizon_is_refused_before_any_model_is_sized_by_it() {
         text(&out.stderr)
     );
 }
+
+#[test]
+fn charts_are_written_whole_or_not_at_all() {
+    use trajpred::plot::{Chart, Series, write_chart};
+    let dir = scratch("chart");
+    let chart = Chart {
+        title: "t".into(),
+        x_label: "x".into(),
+        y_label: "y".into(),
+        series: vec![Series {
+            label: "s".into(),
+            points: vec![(0.0, 0.0), (1.0, 2.0), (2.0, 1.0)],
+            markers: true,
+        }],
+        log_y: false,
+    };
+    let svg = dir.join("c.svg");
+    std::fs::write(&svg, "old").expect("old file");
+    write_chart(&chart, &svg).expect("writes");
+    let text = std::fs::read_to_string(&svg).expect("svg");
+    assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"));
+    // the rename cannot happen over a folder: the error names the output, and neither the
+    // folder nor a temporary file is left changed behind
+    let blocked = dir.join("blocked.png");
+    std::fs::create_dir_all(blocked.join("inside")).expect("folder");
+    match write_chart(&chart, &blocked) {
+        Err(Error::InvalidParameter {
+            name: "output",
+            reason,
+        }) => {
+            assert!(reason.contains("blocked.png"), "{reason}")
+        }
+        other => panic!("expected an output error, got {other:?}"),
+    }
+    assert!(blocked.join("inside").is_dir());
+    let left: Vec<String> = std::fs::read_dir(&dir)
+        .expect("dir")
+        .filter_map(|e| e.ok().map(|e| e.file_name().to_string_lossy().into_owned()))
+        .collect();
+    assert!(left.iter().all(|n| !n.contains(".tmp-")), "{left:?}");
+}
