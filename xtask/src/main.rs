@@ -64,7 +64,7 @@ enum Command {
         #[arg(long, default_value = "../shared/data")]
         data: PathBuf,
         /// Where to write the run (default target/reproduce, or target/reproduce-quick with
-        /// --quick); each paper in <out>/<slug>/, with an index <out>/README.md.
+        /// --quick); each paper in `OUT/SLUG/`, with an index `OUT/README.md`.
         #[arg(long)]
         out: Option<PathBuf>,
         /// Base seed of every random choice.
