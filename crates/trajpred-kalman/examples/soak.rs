@@ -49,7 +49,10 @@ where
         return Err(format!("not square: {n}x{}", p.ncols()));
     }
     if let Some(i) = p.iter().position(|v| !v.is_finite()) {
-        return Err(format!("non-finite entry {i}: {}", p.iter().nth(i).copied().unwrap_or(0.0)));
+        return Err(format!(
+            "non-finite entry {i}: {}",
+            p.iter().nth(i).copied().unwrap_or(0.0)
+        ));
     }
     let scale = p.iter().fold(1.0f64, |m, v| m.max(v.abs()));
     let mut asym = 0.0f64;
@@ -59,13 +62,17 @@ where
         }
     }
     if asym > SYM_TOL * scale {
-        return Err(format!("asymmetric: |P - P^T|_max = {asym:e}, |P|_max = {scale:e}"));
+        return Err(format!(
+            "asymmetric: |P - P^T|_max = {asym:e}, |P|_max = {scale:e}"
+        ));
     }
     let d = DMatrix::from_fn(n, n, |i, j| 0.5 * (p[(i, j)] + p[(j, i)]));
     let trace = d.trace();
     let min = d.symmetric_eigenvalues().min();
     if min < -PSD_TOL * trace.abs().max(f64::MIN_POSITIVE) {
-        return Err(format!("not PSD: smallest eigenvalue {min:e}, trace {trace:e}"));
+        return Err(format!(
+            "not PSD: smallest eigenvalue {min:e}, trace {trace:e}"
+        ));
     }
     Ok(())
 }
@@ -98,9 +105,36 @@ pub struct Part {
     pub seconds: f64,
     /// Largest `trace P` seen at a check.
     pub max_trace: f64,
+    /// Sum of the position NEES `e^T P_pos^-1 e` at the checks (`e`: estimated minus true
+    /// position, `P_pos` the position block; 2 on average for a consistent filter).
+    pub nees_sum: f64,
+    /// Number of NEES values summed.
+    pub nees_n: u64,
 }
 
 impl Part {
+    /// The mean position NEES at the checks.
+    pub fn mean_nees(&self) -> f64 {
+        self.nees_sum / self.nees_n.max(1) as f64
+    }
+
+    /// Adds the position NEES of `state` (positions at indices 0 and 2) against `truth`.
+    fn nees<D: Dim>(&mut self, state: &Gaussian<f64, D>, truth: Vector2<f64>)
+    where
+        DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    {
+        let p = &state.covariance;
+        let e = Vector2::new(state.mean[0] - truth[0], state.mean[2] - truth[1]);
+        let block = Matrix2::new(p[(0, 0)], p[(0, 2)], p[(2, 0)], p[(2, 2)]);
+        match block.try_inverse() {
+            Some(inv) if (e.transpose() * inv * e)[0].is_finite() => {
+                self.nees_sum += (e.transpose() * inv * e)[0];
+                self.nees_n += 1;
+            }
+            _ => self.fail(format!("position block not invertible: {block:?}")),
+        }
+    }
+
     fn fail(&mut self, what: String) {
         self.violations += 1;
         if self.messages.len() < 5 {
@@ -135,14 +169,14 @@ fn gauss(rng: &mut ChaCha8Rng) -> f64 {
     rng.sample(StandardNormal)
 }
 
-/// Runs `filter` from `state` for `steps` steps, `observe` giving each step's observation
-/// (`None`: missing); checks every `check_every` steps.
+/// Runs `filter` from `state` for `steps` steps, `observe` giving each step's true position
+/// and observation (`None`: missing); checks every `check_every` steps.
 fn run_track<D, F>(
     filter: &F,
     mut state: Gaussian<f64, D>,
     steps: u64,
     check_every: u64,
-    mut observe: impl FnMut() -> Option<Vector2<f64>>,
+    mut observe: impl FnMut() -> (Vector2<f64>, Option<Vector2<f64>>),
     part: &mut Part,
     tamper: Option<Tamper>,
 ) where
@@ -152,7 +186,7 @@ fn run_track<D, F>(
 {
     part.tracks += 1;
     for k in 1..=steps {
-        let z = observe();
+        let (truth, z) = observe();
         let step = match filter.step(&state, z.as_ref()) {
             Ok(s) => s,
             Err(e) => {
@@ -169,7 +203,8 @@ fn run_track<D, F>(
             part.fail(format!("step {k}: log-likelihood {ll}"));
         }
         state = step.posterior().clone();
-        if k % check_every == 0 || k == steps {
+        if k.is_multiple_of(check_every) || k == steps {
+            part.nees(&state, truth);
             match tamper {
                 None => part.check(&state.covariance, k),
                 Some(t) => {
@@ -204,7 +239,12 @@ pub fn soak_kf(
         let n = left.min(track_len);
         left -= n;
         // truth [x, vx, y, vy], white acceleration
-        let mut x = [gauss(rng) * 100.0, gauss(rng) * 5.0, gauss(rng) * 100.0, gauss(rng) * 5.0];
+        let mut x = [
+            gauss(rng) * 100.0,
+            gauss(rng) * 5.0,
+            gauss(rng) * 100.0,
+            gauss(rng) * 5.0,
+        ];
         let state = Gaussian {
             mean: nalgebra::Vector4::new(x[0], 0.0, x[2], 0.0),
             covariance: nalgebra::Matrix4::from_diagonal(&nalgebra::Vector4::new(
@@ -218,14 +258,15 @@ pub fn soak_kf(
                 x[o] += x[o + 1] * dt + 0.5 * a * dt * dt;
                 x[o + 1] += a * dt;
             }
-            if rng.random_bool(0.1) {
+            let z = if rng.random_bool(0.1) {
                 None
             } else {
                 Some(Vector2::new(
                     x[0] + gauss(rng) * 0.3f64.sqrt(),
                     x[2] + gauss(rng) * 0.3f64.sqrt(),
                 ))
-            }
+            };
+            (Vector2::new(x[0], x[2]), z)
         };
         run_track(&kf, state, n, check_every, observe, &mut part, tamper);
     }
@@ -247,13 +288,13 @@ pub fn soak_ukf(
     let ct = CoordinatedTurn::<f64>::new(dt, 0.2, 1e-3).expect("model");
     let truth = CoordinatedTurn::<f64>::new(dt, 0.0, 0.0).expect("model");
     let (range_var, bearing_var, pos_var) = (0.5, 1e-4, 4.0);
-    let rb = RangeBearing::new(Vector2::new(0.0, 0.0), 0, 2, range_var, bearing_var)
-        .expect("model");
+    let rb =
+        RangeBearing::new(Vector2::new(0.0, 0.0), 0, 2, range_var, bearing_var).expect("model");
     let mut h = Matrix2x5::zeros();
     h[(0, 0)] = 1.0;
     h[(1, 2)] = 1.0;
-    let pos = LinearObservation::<f64, U5, U2>::new(h, Matrix2::identity() * pos_var)
-        .expect("model");
+    let pos =
+        LinearObservation::<f64, U5, U2>::new(h, Matrix2::identity() * pos_var).expect("model");
     let ukf_rb = Ukf::new(ct.clone(), rb, MerweSigmaPoints::new(0.5, 2.0, -2.0)).expect("ukf");
     let ukf_pos = Ukf::new(ct, pos, MerweSigmaPoints::new(0.5, 2.0, -2.0)).expect("ukf");
     let mut left = steps;
@@ -276,7 +317,7 @@ pub fn soak_ukf(
                 25.0, 25.0, 25.0, 25.0, 0.01,
             )),
         };
-        let range_bearing = track % 2 == 0;
+        let range_bearing = track.is_multiple_of(2);
         let observe = || {
             if rng.random_bool(0.002) {
                 target = -target;
@@ -285,10 +326,11 @@ pub fn soak_ukf(
             x[4] += 0.05 * (target - x[4]) + gauss(rng) * 1e-3;
             x[1] += gauss(rng) * 0.1;
             x[3] += gauss(rng) * 0.1;
+            let pos = Vector2::new(x[0], x[2]);
             if rng.random_bool(0.1) {
-                return None;
+                return (pos, None);
             }
-            Some(if range_bearing {
+            let z = if range_bearing {
                 let (dx, dy) = (x[0], x[2]);
                 Vector2::new(
                     dx.hypot(dy) + gauss(rng) * range_var.sqrt(),
@@ -301,7 +343,8 @@ pub fn soak_ukf(
                     x[0] + gauss(rng) * pos_var.sqrt(),
                     x[2] + gauss(rng) * pos_var.sqrt(),
                 )
-            })
+            };
+            (pos, Some(z))
         };
         if range_bearing {
             run_track(&ukf_rb, state, n, check_every, observe, &mut part, tamper);
@@ -347,7 +390,12 @@ pub fn soak_driver(
         let n = left.min(track_len);
         left -= n;
         part.tracks += 1;
-        let mut x = [gauss(rng) * 100.0, gauss(rng) * 5.0, gauss(rng) * 100.0, gauss(rng) * 5.0];
+        let mut x = [
+            gauss(rng) * 100.0,
+            gauss(rng) * 5.0,
+            gauss(rng) * 100.0,
+            gauss(rng) * 5.0,
+        ];
         let init = Gaussian {
             mean: nalgebra::Vector4::new(x[0], 0.0, x[2], 0.0),
             covariance: nalgebra::Matrix4::from_diagonal(&nalgebra::Vector4::new(
@@ -359,12 +407,15 @@ pub fn soak_driver(
         let mut done = 0u64;
         let mut times = Vec::with_capacity(chunk + 1);
         let mut obs: Vec<Option<Vector2<f64>>> = Vec::with_capacity(chunk + 1);
+        let mut truth: Vec<Vector2<f64>> = Vec::with_capacity(chunk + 1);
         while done < n {
             let m = (n - done).min(chunk as u64) as usize;
             times.clear();
             obs.clear();
+            truth.clear();
             times.push(t);
             obs.push(None);
+            truth.push(Vector2::new(x[0], x[2]));
             for _ in 0..m {
                 if !rng.random_bool(0.7) {
                     dt = rng.random_range(0.01..3.0);
@@ -378,6 +429,7 @@ pub fn soak_driver(
                     x[o + 1] += a * dt;
                 }
                 times.push(t);
+                truth.push(Vector2::new(x[0], x[2]));
                 obs.push(if rng.random_bool(0.1) {
                     None
                 } else {
@@ -391,7 +443,8 @@ pub fn soak_driver(
             let mut checks = Part::default();
             let res = drive(&mut f, &times, &obs, |k, f| {
                 let at = base + k as u64;
-                if at % check_every == 0 || k == m {
+                if at.is_multiple_of(check_every) || k == m {
+                    checks.nees(f.state(), truth[k]);
                     match tamper {
                         None => checks.check(&f.state().covariance, at),
                         Some(tm) => {
@@ -411,6 +464,8 @@ pub fn soak_driver(
             part.checks += checks.checks;
             part.violations += checks.violations;
             part.max_trace = part.max_trace.max(checks.max_trace);
+            part.nees_sum += checks.nees_sum;
+            part.nees_n += checks.nees_n;
             part.messages.extend(checks.messages.into_iter().take(5));
             match res {
                 Ok(estimates) => {
@@ -430,9 +485,10 @@ pub fn soak_driver(
 }
 
 /// Prints one part's figures.
+#[allow(clippy::print_stdout)] // a report on the terminal is the point of the example
 pub fn print(name: &str, p: &Part) {
     println!(
-        "{name:<7} steps {:>9}  updates {:>9}  tracks {:>3}  checks {:>6}  violations {}  errors {}  max trace P {:.3e}  {:.1} s ({:.0} steps/s)",
+        "{name:<7} steps {:>9}  updates {:>9}  tracks {:>3}  checks {:>6}  violations {}  errors {}  max trace P {:.3e}  mean position NEES {:.2}  {:.1} s ({:.0} steps/s)",
         p.steps,
         p.updates,
         p.tracks,
@@ -440,6 +496,7 @@ pub fn print(name: &str, p: &Part) {
         p.violations,
         p.errors,
         p.max_trace,
+        p.mean_nees(),
         p.seconds,
         p.steps as f64 / p.seconds.max(1e-9)
     );
@@ -448,15 +505,20 @@ pub fn print(name: &str, p: &Part) {
     }
 }
 
+#[allow(clippy::print_stdout)]
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let total: u64 = args.first().map_or(10_000_000, |s| s.parse().expect("steps"));
+    let total: u64 = args
+        .first()
+        .map_or(10_000_000, |s| s.parse().expect("steps"));
     let seed: u64 = args.get(1).map_or(0, |s| s.parse().expect("seed"));
     let track_len = 1_000_000;
     let check_every = 1_000;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let rss0 = vm_rss_kib();
-    println!("soak: {total} steps, seed {seed}, tracks of up to {track_len}, checks every {check_every}");
+    println!(
+        "soak: {total} steps, seed {seed}, tracks of up to {track_len}, checks every {check_every}"
+    );
     println!("VmRSS at start: {rss0:?} KiB");
     let kf = soak_kf(total * 4 / 10, track_len, check_every, &mut rng, None);
     let rss1 = vm_rss_kib();
@@ -464,6 +526,7 @@ fn main() {
     println!("VmRSS after KF: {rss1:?} KiB");
     let ukf = soak_ukf(total * 3 / 10, track_len, check_every, &mut rng, None);
     print("UKF", &ukf);
+    println!("VmRSS after UKF: {:?} KiB", vm_rss_kib());
     let drv = soak_driver(
         total - total * 4 / 10 - total * 3 / 10,
         track_len,

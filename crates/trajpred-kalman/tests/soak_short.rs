@@ -18,8 +18,14 @@ fn assert_clean(name: &str, p: &Part, steps: u64) {
     assert_eq!(p.violations, 0, "{name}: {:?}", p.messages);
     assert_eq!(p.errors, 0, "{name}: {:?}", p.messages);
     assert!(p.checks >= steps / 100, "{name}: {} checks", p.checks);
-    assert!(p.updates > steps / 2 && p.updates < steps, "{name}: {} updates", p.updates);
+    assert!(
+        p.updates > steps / 2 && p.updates < steps,
+        "{name}: {} updates",
+        p.updates
+    );
     assert!(p.max_trace.is_finite() && p.max_trace > 0.0, "{name}");
+    assert_eq!(p.nees_n, p.checks, "{name}: a NEES at every check");
+    assert!(p.mean_nees().is_finite(), "{name}");
 }
 
 #[test]
@@ -28,11 +34,36 @@ fn a_short_soak_keeps_every_invariant() {
     let kf = soak_kf(40_000, 10_000, 100, &mut rng, None);
     assert_clean("KF", &kf, 40_000);
     assert_eq!(kf.tracks, 4);
+    // the linear filters on their own model are consistent: position NEES about 2
+    // (chi-squared with 2 degrees of freedom)
+    assert!(
+        (1.0..4.0).contains(&kf.mean_nees()),
+        "KF NEES {}",
+        kf.mean_nees()
+    );
     let ukf = soak_ukf(30_000, 10_000, 100, &mut rng, None);
     assert_clean("UKF", &ukf, 30_000);
     assert_eq!(ukf.tracks, 3, "range-bearing, position, range-bearing");
     let drv = soak_driver(30_000, 10_000, 100, &mut rng, None);
     assert_clean("driver", &drv, 30_000);
+    assert!(
+        (1.0..4.0).contains(&drv.mean_nees()),
+        "driver NEES {}",
+        drv.mean_nees()
+    );
+    // tracks of 10^4 steps stay near the sensor: the UKF is consistent too (over tracks of
+    // 10^6 steps, range-bearing at tens of km, it is not: docs/reliability.md)
+    assert!(
+        (1.0..4.0).contains(&ukf.mean_nees()),
+        "UKF NEES {}",
+        ukf.mean_nees()
+    );
+    eprintln!(
+        "NEES: KF {:.2}, UKF {:.2}, driver {:.2}",
+        kf.mean_nees(),
+        ukf.mean_nees(),
+        drv.mean_nees()
+    );
 }
 
 #[test]
@@ -71,5 +102,8 @@ fn a_broken_covariance_fails_the_soak() {
     assert_eq!(ukf.violations, ukf.checks);
     assert!(ukf.messages[0].contains("not PSD"), "{:?}", ukf.messages);
     let drv = soak_driver(2_000, 1_000, 100, &mut rng, Some(break_symmetry));
-    assert!(drv.violations > 0 && drv.violations == drv.checks, "{drv:?}");
+    assert!(
+        drv.violations > 0 && drv.violations == drv.checks,
+        "{drv:?}"
+    );
 }
