@@ -496,6 +496,8 @@ pub fn run_one(target: Target, input: &[u8], opts: &LoadOptions, scratch: &Path)
             Err(e) => Outcome::Err(label(&e)),
         },
         Target::GzAdsb | Target::GzCsv => {
+            // a fresh file each time: rewriting a truncated one makes ext4 flush it on close
+            let _ = std::fs::remove_file(scratch);
             if let Err(e) = std::fs::write(scratch, input) {
                 return Outcome::Err(format!("scratch write failed: {e}"));
             }
