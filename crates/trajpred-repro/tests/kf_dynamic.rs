@@ -1,4 +1,4 @@
-//! The KF-dynamic paper's runner (SPEC B.4): without data, on tiny fixtures written here in
+//! The KF-dynamic paper's runner (`docs/papers.md` B.4): without data, on tiny fixtures written here in
 //! the GeoLife and T-Drive formats, and (when `../shared/data` is present) on the real subset
 //! in quick mode.
 

@@ -1,4 +1,4 @@
-//! The MKPF runner (SPEC C.2): the quick run writes its files with and without the ADS-B
+//! The MKPF runner (`docs/papers.md` C.2): the quick run writes its files with and without the ADS-B
 //! data, a table cell agrees with an independent computation, and the same seed gives the same
 //! tables.
 
