@@ -279,8 +279,8 @@ impl KfuLstmNet {
         })
     }
 
-    /// The patent's settings (`docs/papers.md` D.1): 2 x 64 LSTM + two fully connected layers, Xavier
-    /// weights, zero biases, Adam at learning rate 1e-4 (noise parameters 1e-2), batch 16,
+    /// The patent's settings (`docs/papers.md` D.1): 2 x 64 LSTM + two fully connected layers,
+    /// Xavier weights, zero biases, Adam at learning rate 1e-4 (noise parameters 1e-2), batch 16,
     /// 300 epochs, sub-sequences of 50 steps every 10 steps, seed 0.
     pub fn patent() -> Result<Self> {
         KfuLstmNet::new(
@@ -350,8 +350,9 @@ impl KfuLstmNet {
         cell
     }
 
-    /// Trains with the loss of `docs/papers.md` D.1, `MSE(y(t|t), truth) + 0.5 MSE(y(t|t-1), truth)`,
-    /// on noisy `observed` trajectories whose clean `truth` is known (same lengths).
+    /// Trains with the loss of `docs/papers.md` D.1,
+    /// `MSE(y(t|t), truth) + 0.5 MSE(y(t|t-1), truth)`, on noisy `observed` trajectories whose
+    /// clean `truth` is known (same lengths).
     pub fn fit_supervised(
         &mut self,
         observed: &[Trajectory],

@@ -1,6 +1,6 @@
 //! The particle filters under the filter driver of `trajpred-kalman`
 //! ([`trajpred_kalman::driver`]): [`TimedParticles`] runs a [`ParticleFilter`] or an
-//! [`Mkpf`](crate::Mkpf) by time steps, rebuilding its transition (and so its process noise)
+//! [`Mkpf`] by time steps, rebuilding its transition (and so its process noise)
 //! when the step changes, with its own injected random number generator.
 //!
 //! ```

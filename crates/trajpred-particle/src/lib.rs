@@ -28,8 +28,8 @@
 //! Both filters reuse the Kalman crate's steps and model traits
 //! ([`trajpred_kalman::Transition`], [`trajpred_kalman::Observation`] and their Jacobian
 //! versions; the MKPF calls [`trajpred_kalman::Ukf`] and [`trajpred_kalman::Ekf`]). What
-//! `docs/papers.md` C leaves open, and what this crate chose, is in `docs/particle.md`: the prior of each
-//! particle's UKF step ([`ParticlePrior`]), how the EKF step uses the UKF result
+//! `docs/papers.md` C leaves open, and what this crate chose, is in `docs/particle.md`: the prior
+//! of each particle's UKF step ([`ParticlePrior`]), how the EKF step uses the UKF result
 //! ([`EkfStage`]), the ESS rule ([`ResamplePolicy`]), the recovery when every weight is zero
 //! ([`ParticleError::AllWeightsZero`], filter left unchanged).
 //!

@@ -1,5 +1,5 @@
-//! [`Mkpf`]: the particle filter of the MKPF paper (`docs/papers.md` C.1), whose every particle carries
-//! a mean and a covariance and proposes from a UKF step followed by an EKF step, both the
+//! [`Mkpf`]: the particle filter of the MKPF paper (`docs/papers.md` C.1), whose every particle
+//! carries a mean and a covariance and proposes from a UKF step followed by an EKF step, both the
 //! Kalman crate's own (`trajpred_kalman::Ukf`, `trajpred_kalman::Ekf`).
 
 use crate::cloud::ParticleCloud;
@@ -42,8 +42,8 @@ pub enum EkfStage {
     UkfOnly,
 }
 
-/// Which prior the UKF step of particle `i` starts from (`docs/papers.md` C.1 leaves the meaning of the
-/// particle's "mean and covariance" open; see `docs/particle.md`).
+/// Which prior the UKF step of particle `i` starts from (`docs/papers.md` C.1 leaves the meaning of
+/// the particle's "mean and covariance" open; see `docs/particle.md`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum ParticlePrior {
     /// Default: the paper's Algorithm 1 (van der Merwe's unscented particle filter). The UKF

@@ -54,7 +54,8 @@ pub struct HmmModel {
     pub emission_variance: f64,
 }
 
-/// HMM motion-state predictor (`docs/papers.md` B.2). Assumes a uniform sampling step (resample first).
+/// HMM motion-state predictor (`docs/papers.md` B.2). Assumes a uniform sampling step (resample
+/// first).
 ///
 /// ```
 /// use trajpred::predictors::{Hmm, HmmParams};
