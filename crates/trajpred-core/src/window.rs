@@ -1,5 +1,5 @@
 //! Sliding windows and the Hankel design matrices of multi-step linear prediction
-//! (SPEC A.3, eq. 4 and 14-16 of the GSKF paper).
+//! (`docs/papers.md` A.3, eq. 4 and 14-16 of the GSKF paper).
 //!
 //! For a series `x_0 .. x_{h-1}`, window length `m` and horizon `t >= 1`, row `j` of the design
 //! `D_t` is the window `(x_j, ..., x_{j+m-1})` and the target is `x_{j+m-1+t}`, for

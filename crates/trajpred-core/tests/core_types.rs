@@ -1,5 +1,5 @@
 //! Tests of the core types: invariants, the first bad index, and the Hankel construction of
-//! SPEC A.3 checked against windows written out by hand.
+//! `docs/papers.md` A.3 checked against windows written out by hand.
 
 use approx::assert_abs_diff_eq;
 use nalgebra::{Const, DMatrix, DVector, Dyn, Matrix2, Vector2};

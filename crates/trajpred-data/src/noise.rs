@@ -1,4 +1,4 @@
-//! Additive white Gaussian noise at a given signal-to-noise ratio (SPEC E).
+//! Additive white Gaussian noise at a given signal-to-noise ratio (`docs/papers.md` E).
 //!
 //! Per axis, `σ² = mean(signal²) / 10^(SNR/10)` (SNR in dB, the signal's mean power about
 //! zero, not about its mean), and independent `N(0, σ²)` noise is added to every value.

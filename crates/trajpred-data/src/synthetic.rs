@@ -3,8 +3,8 @@
 //!
 //! - [`gskf_eq20`]: eq. (20) of the MSTPM-GSKF paper, 1000 points at `t_i = 0.01 π i`;
 //! - [`PatentCurve`]: the three simulated 3-D curves of the KFU-LSTM-Net patent, whose
-//!   equations the patent does not give; the project's choice (SPEC D.2) is written on each
-//!   variant and in `docs/data.md`.
+//!   equations the patent does not give; the project's choice (`docs/papers.md` D.2) is written
+//!   on each variant and in `docs/data.md`.
 //!
 //! ```
 //! use trajpred_data::synthetic::{gskf_eq20, PatentCurve};
@@ -47,7 +47,7 @@ pub fn gskf_eq20_n(n: usize) -> Result<Trajectory> {
     Ok(Trajectory::from_axes(times, axes)?)
 }
 
-/// Eq. (20) of the GSKF paper exactly as SPEC A.5: 1000 points, `t_i = i * 0.01 π`,
+/// Eq. (20) of the GSKF paper exactly as `docs/papers.md` A.5: 1000 points, `t_i = i * 0.01 π`,
 /// `i = 0..=999`, metres. Train on the first 800, test on the last 200.
 pub fn gskf_eq20() -> Trajectory {
     match gskf_eq20_n(GSKF_POINTS) {
@@ -57,8 +57,8 @@ pub fn gskf_eq20() -> Trajectory {
     }
 }
 
-/// The three simulated 3-D curves of the KFU-LSTM-Net patent (SPEC D.2: the patent's table
-/// of equations is missing; these are the project's choice). Time `t` in seconds, metres.
+/// The three simulated 3-D curves of the KFU-LSTM-Net patent (`docs/papers.md` D.2: the patent's
+/// table of equations is missing; these are the project's choice). Time `t` in seconds, metres.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum PatentCurve {
     /// A helix: `x = 10 cos(0.2 t)`, `y = 10 sin(0.2 t)`, `z = 0.5 t`.

@@ -1,5 +1,5 @@
 //! The synthetic trajectories against values worked out by hand from the equations, and the
-//! noise generator against its definition (SPEC E).
+//! noise generator against its definition (`docs/papers.md` E).
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

@@ -1,4 +1,4 @@
-//! The augmented unscented Kalman filter of the MKPF paper (SPEC C.1, eq. 12-19): the
+//! The augmented unscented Kalman filter of the MKPF paper (`docs/papers.md` C.1, eq. 12-19): the
 //! sigma points are drawn once per step in the augmented space `[x; w; v]` with covariance
 //! `blockdiag(P, Q, R)`, propagated through `f(x, w)` and then `h(f(x, w), v)`, so noise that
 //! enters the models non-additively is handled exactly as the paper does.
@@ -71,8 +71,8 @@ impl<T: RealField + Copy, D: Dim> NoisyObservation<T, D, U2> for RangeBearing<T>
 {
 }
 
-/// The augmented UKF (SPEC C.1 eq. 12-19). One [`AugmentedUkf::step`] draws `2L + 1` sigma
-/// points of `N([x; 0; 0], blockdiag(P, Q, R))`, `L = 2n + m`, with Merwe's weights for
+/// The augmented UKF (`docs/papers.md` C.1 eq. 12-19). One [`AugmentedUkf::step`] draws `2L + 1`
+/// sigma points of `N([x; 0; 0], blockdiag(P, Q, R))`, `L = 2n + m`, with Merwe's weights for
 /// dimension `L`; the prior is the weighted mean and spread of `Y_i = f(x_i, w_i)`; the
 /// update uses `Z_i = h(Y_i, v_i)` (no redraw): `z_hat`, `S`, `Pxz` from the same points,
 /// `K = Pxz S^-1`, `x = y_bar + K (z - z_hat)`, `P = P_bar - K S K^T`. No `Q` or `R` is added:

@@ -1,4 +1,4 @@
-//! The improved one-step-ahead Kalman filter [`Ikf`] of the MSTPM-GSKF paper (SPEC A.4,
+//! The improved one-step-ahead Kalman filter [`Ikf`] of the MSTPM-GSKF paper (`docs/papers.md` A.4,
 //! eq. 12-13).
 //!
 //! At prediction time the observation `Z(k)` is not known yet, so the paper replaces the
@@ -77,7 +77,7 @@ where
     pub innovation: Option<Innovation<T, M>>,
 }
 
-/// The improved one-step-ahead Kalman filter (SPEC A.4), for any `F`, `H`, `Q`, `R`,
+/// The improved one-step-ahead Kalman filter (`docs/papers.md` A.4), for any `F`, `H`, `Q`, `R`,
 /// static or dynamic sizes (the GSKF chooses the state size `T` at run time).
 ///
 /// ```

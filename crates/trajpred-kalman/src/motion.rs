@@ -24,7 +24,7 @@ pub enum StateOrder {
     #[default]
     AxisBlocks,
     /// All positions, then all velocities (then accelerations): `[x, y, vx, vy]`, the order
-    /// of the KF-dynamic paper (SPEC B.1).
+    /// of the KF-dynamic paper (`docs/papers.md` B.1).
     PositionsFirst,
 }
 

@@ -11,7 +11,7 @@ use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
 use trajpred_core::Gaussian;
 
-/// Merwe's scaled sigma points (SPEC C.1 eq. 10-11): for a state of dimension `n`,
+/// Merwe's scaled sigma points (`docs/papers.md` C.1 eq. 10-11): for a state of dimension `n`,
 /// `lambda = alpha^2 (n + kappa) - n`, the `2n + 1` points `x`, `x + sqrt((n+lambda) P)_i`,
 /// `x - sqrt((n+lambda) P)_i` (columns of the lower Cholesky factor; filterpy's order),
 /// with weights `W0m = lambda / (n + lambda)`, `W0c = W0m + 1 - alpha^2 + beta`,
@@ -97,7 +97,7 @@ impl<T: RealField + Copy> MerweSigmaPoints<T> {
 }
 
 impl<T: RealField + Copy> Default for MerweSigmaPoints<T> {
-    /// `alpha = 1e-3`, `beta = 2`, `kappa = 0`: the typical values of SPEC C.1.
+    /// `alpha = 1e-3`, `beta = 2`, `kappa = 0`: the typical values of `docs/papers.md` C.1.
     fn default() -> Self {
         MerweSigmaPoints {
             alpha: nalgebra::convert(1e-3),

@@ -1,7 +1,7 @@
 //! # trajpred-metrics
 //!
 //! Every error measure the trajpred papers use, each named for what it computes
-//! (SPEC section E). All functions take predicted and true points as slices of anything that
+//! (`docs/papers.md` E). All functions take predicted and true points as slices of anything that
 //! views as `&[f64]` (a [`Vec<f64>`], an array, a `trajpred_core::Point`), check them, and
 //! return a typed [`MetricsError`] for empty, mismatched or non-finite input.
 //!

@@ -7,7 +7,7 @@ use std::time::Instant;
 use trajpred_core::Trajectory;
 use trajpred_neural::{KfuLstmNet, LstmNet, Mlp, RnnNet, TrainConfig};
 
-/// SPEC A.5 eq. 20: 1000 points, t_i = 0.01 pi i; the first 800 are the training part.
+/// `docs/papers.md` A.5 eq. 20: 1000 points, t_i = 0.01 pi i; the first 800 are the training part.
 fn eq20(n: usize) -> Trajectory {
     let t: Vec<f64> = (0..n)
         .map(|i| i as f64 * 0.01 * std::f64::consts::PI)

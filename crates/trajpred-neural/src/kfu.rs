@@ -1,4 +1,4 @@
-//! [`KfuLstmNet`]: the Kalman-filter-unfolded LSTM of the patent (SPEC D.1).
+//! [`KfuLstmNet`]: the Kalman-filter-unfolded LSTM of the patent (`docs/papers.md` D.1).
 //!
 //! Per step `t` an LSTM (stacked layers, then fully connected layers) maps the previous
 //! posterior to the prior `y(t|t-1) = y(t-1|t-1) + f(y(t-1|t-1))`; the diagonal Kalman update
@@ -234,11 +234,11 @@ struct KfuHeader {
     report: TrainReport,
 }
 
-/// The Kalman-filter-unfolded LSTM network (SPEC D.1) as a one-step-ahead predictor.
+/// The Kalman-filter-unfolded LSTM network (`docs/papers.md` D.1) as a one-step-ahead predictor.
 ///
 /// - Inputs are z-scored per axis with the training data's statistics; outputs are
 ///   de-standardised.
-/// - [`KfuLstmNet::fit_supervised`] trains with the loss SPEC decides,
+/// - [`KfuLstmNet::fit_supervised`] trains with the loss decided in `docs/papers.md` D.1,
 ///   `MSE(y(t|t), truth) + 0.5 MSE(y(t|t-1), truth)`, when the clean truth of the training
 ///   trajectories is known; [`Predictor::fit`] has only observations and trains the one-step
 ///   prediction error `MSE(y(t|t-1), z(t))` instead (see `docs/neural.md`).
@@ -279,8 +279,8 @@ impl KfuLstmNet {
         })
     }
 
-    /// The patent's settings (SPEC D.1): 2 x 64 LSTM + two fully connected layers, Xavier
-    /// weights, zero biases, Adam at learning rate 1e-4 (noise parameters 1e-2), batch 16,
+    /// The patent's settings (`docs/papers.md` D.1): 2 x 64 LSTM + two fully connected layers,
+    /// Xavier weights, zero biases, Adam at learning rate 1e-4 (noise parameters 1e-2), batch 16,
     /// 300 epochs, sub-sequences of 50 steps every 10 steps, seed 0.
     pub fn patent() -> Result<Self> {
         KfuLstmNet::new(
@@ -350,8 +350,9 @@ impl KfuLstmNet {
         cell
     }
 
-    /// Trains with the loss of SPEC D.1, `MSE(y(t|t), truth) + 0.5 MSE(y(t|t-1), truth)`,
-    /// on noisy `observed` trajectories whose clean `truth` is known (same lengths).
+    /// Trains with the loss of `docs/papers.md` D.1,
+    /// `MSE(y(t|t), truth) + 0.5 MSE(y(t|t-1), truth)`, on noisy `observed` trajectories whose
+    /// clean `truth` is known (same lengths).
     pub fn fit_supervised(
         &mut self,
         observed: &[Trajectory],

@@ -601,8 +601,8 @@ fn gskf_train(epochs: usize) -> TrainConfig {
 }
 
 impl WindowNet<MlpArch> {
-    /// The GSKF paper's "BP" baseline of Table 3 (SPEC A.5): per axis, `m` inputs -> `T`
-    /// outputs, one hidden layer of 10 tanh units (MATLAB's `newff` default), plain gradient
+    /// The GSKF paper's "BP" baseline of Table 3 (`docs/papers.md` A.5): per axis, `m` inputs ->
+    /// `T` outputs, one hidden layer of 10 tanh units (MATLAB's `newff` default), plain gradient
     /// descent at learning rate 0.1, 500 epochs, batch 32, seed 0.
     pub fn gskf_bp(window: usize, horizon: usize) -> Result<Self> {
         WindowNet::new(
@@ -621,8 +621,8 @@ impl WindowNet<MlpArch> {
 }
 
 impl WindowNet<LstmArch> {
-    /// The GSKF paper's LSTM baseline of Table 3 (SPEC A.5): per axis, 2 x 64 LSTM + one
-    /// fully connected hidden layer of 64, plain gradient descent at learning rate 0.1,
+    /// The GSKF paper's LSTM baseline of Table 3 (`docs/papers.md` A.5): per axis, 2 x 64 LSTM +
+    /// one fully connected hidden layer of 64, plain gradient descent at learning rate 0.1,
     /// 500 epochs, batch 32, seed 0.
     pub fn gskf_lstm(window: usize, horizon: usize) -> Result<Self> {
         WindowNet::new(
@@ -636,7 +636,7 @@ impl WindowNet<LstmArch> {
         )
     }
 
-    /// The patent's LSTM baseline (SPEC D.1): all axes jointly, 2 x 64 LSTM + fully
+    /// The patent's LSTM baseline (`docs/papers.md` D.1): all axes jointly, 2 x 64 LSTM + fully
     /// connected layers, Adam at learning rate 1e-3, batch 16, 100 epochs, seed 0.
     pub fn patent_baseline(window: usize, horizon: usize) -> Result<Self> {
         WindowNet::new(
@@ -652,7 +652,7 @@ impl WindowNet<LstmArch> {
 }
 
 impl WindowNet<RnnArch> {
-    /// The patent's RNN baseline (SPEC D.1): all axes jointly, 2 x 64 Elman RNN + fully
+    /// The patent's RNN baseline (`docs/papers.md` D.1): all axes jointly, 2 x 64 Elman RNN + fully
     /// connected layers, Adam at learning rate 1e-3, batch 16, 100 epochs, seed 0.
     pub fn patent_baseline(window: usize, horizon: usize) -> Result<Self> {
         WindowNet::new(

@@ -10,8 +10,8 @@ use rand::Rng;
 use trajpred_core::Gaussian;
 
 /// Weighted particles `{x_i, w_i}`: the empirical approximation
-/// `p(x) ~ sum_i w_i delta(x - x_i)` (SPEC C eq. 2), with the weights kept in log space and
-/// normalised (`sum_i exp(l_i) = 1`).
+/// `p(x) ~ sum_i w_i delta(x - x_i)` (`docs/papers.md` C eq. 2), with the weights kept in log space
+/// and normalised (`sum_i exp(l_i) = 1`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ParticleCloud<T: RealField, D: Dim>
 where

@@ -1,8 +1,8 @@
 //! Particle filters for trajpred: resampling, log-space weights, the bootstrap particle
 //! filter and the MKPF of Zhao, Xiong, Xiao and Xu (2015), whose proposal is a UKF step
-//! followed by an EKF step (SPEC C).
+//! followed by an EKF step (`docs/papers.md` C).
 //!
-//! # The method (SPEC C.1, the paper's equations)
+//! # The method (`docs/papers.md` C.1, the paper's equations)
 //!
 //! The posterior is approximated by weighted particles (eq. 2)
 //! `p(x_0:k | z_1:k) ≈ sum_i w_k^i δ(x_0:k - x_0:k^i)`, so expectations become weighted sums
@@ -28,8 +28,8 @@
 //! Both filters reuse the Kalman crate's steps and model traits
 //! ([`trajpred_kalman::Transition`], [`trajpred_kalman::Observation`] and their Jacobian
 //! versions; the MKPF calls [`trajpred_kalman::Ukf`] and [`trajpred_kalman::Ekf`]). What
-//! SPEC C leaves open, and what this crate chose, is in `docs/particle.md`: the prior of each
-//! particle's UKF step ([`ParticlePrior`]), how the EKF step uses the UKF result
+//! `docs/papers.md` C leaves open, and what this crate chose, is in `docs/particle.md`: the prior
+//! of each particle's UKF step ([`ParticlePrior`]), how the EKF step uses the UKF result
 //! ([`EkfStage`]), the ESS rule ([`ResamplePolicy`]), the recovery when every weight is zero
 //! ([`ParticleError::AllWeightsZero`], filter left unchanged).
 //!

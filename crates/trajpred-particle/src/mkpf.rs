@@ -1,5 +1,5 @@
-//! [`Mkpf`]: the particle filter of the MKPF paper (SPEC C.1), whose every particle carries
-//! a mean and a covariance and proposes from a UKF step followed by an EKF step, both the
+//! [`Mkpf`]: the particle filter of the MKPF paper (`docs/papers.md` C.1), whose every particle
+//! carries a mean and a covariance and proposes from a UKF step followed by an EKF step, both the
 //! Kalman crate's own (`trajpred_kalman::Ukf`, `trajpred_kalman::Ekf`).
 
 use crate::cloud::ParticleCloud;
@@ -23,7 +23,7 @@ use trajpred_kalman::{
     Observation, ObservationJacobian, TransitionJacobian, Ukf,
 };
 
-/// How the EKF step of the MKPF proposal uses the UKF step's result (SPEC C.1 leaves it
+/// How the EKF step of the MKPF proposal uses the UKF step's result (`docs/papers.md` C.1 leaves it
 /// open; see `docs/particle.md`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum EkfStage {
@@ -42,8 +42,8 @@ pub enum EkfStage {
     UkfOnly,
 }
 
-/// Which prior the UKF step of particle `i` starts from (SPEC C.1 leaves the meaning of the
-/// particle's "mean and covariance" open; see `docs/particle.md`).
+/// Which prior the UKF step of particle `i` starts from (`docs/papers.md` C.1 leaves the meaning of
+/// the particle's "mean and covariance" open; see `docs/particle.md`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum ParticlePrior {
     /// Default: the paper's Algorithm 1 (van der Merwe's unscented particle filter). The UKF
@@ -137,7 +137,7 @@ where
     }
 }
 
-/// The MKPF of Zhao et al. 2015 (SPEC C.1, Algorithm 1). Particle `i` carries a sample
+/// The MKPF of Zhao et al. 2015 (`docs/papers.md` C.1, Algorithm 1). Particle `i` carries a sample
 /// `x^i` and a covariance `P^i`. At step `k`, for each particle:
 ///
 /// 1. a UKF step (Merwe sigma points, eq. 10-19) from `N(x_(k-1)^i, P_(k-1)^i)` by the

@@ -140,7 +140,7 @@ pub fn effective_sample_size_log(log_weights: &[f64]) -> Result<f64> {
 /// When a particle filter resamples after weighting.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum ResamplePolicy {
-    /// After every step (the MKPF paper, SPEC C.1). Default.
+    /// After every step (the MKPF paper, `docs/papers.md` C.1). Default.
     #[default]
     Always,
     /// When the effective sample size falls below `fraction * N` (`fraction` in `[0, 1]`;

@@ -11,7 +11,7 @@
 //! (`--bless`: the only way `docs/results/` changes). Every file is written atomically
 //! ([`report::write_atomic`]).
 //!
-//! | paper | module | SPEC |
+//! | paper | module | `docs/papers.md` |
 //! |---|---|---|
 //! | MSTPM-GSKF (group sparse coding + improved KF) | [`papers::gskf`] | A.5 |
 //! | Dynamic trajectory prediction with a KF | [`papers::kf_dynamic`] | B.4 |
@@ -39,18 +39,18 @@ use std::time::Instant;
 /// One of the four papers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Paper {
-    /// MSTPM-GSKF: group sparse coding + improved Kalman filter (SPEC A).
+    /// MSTPM-GSKF: group sparse coding + improved Kalman filter (`docs/papers.md` A).
     Gskf,
-    /// Dynamic trajectory prediction with a Kalman filter (SPEC B).
+    /// Dynamic trajectory prediction with a Kalman filter (`docs/papers.md` B).
     KfDynamic,
-    /// MKPF: particle filter with a UKF+EKF proposal (SPEC C).
+    /// MKPF: particle filter with a UKF+EKF proposal (`docs/papers.md` C).
     Mkpf,
-    /// KFU-LSTM-Net: a Kalman-filter-unfolded LSTM (SPEC D).
+    /// KFU-LSTM-Net: a Kalman-filter-unfolded LSTM (`docs/papers.md` D).
     KfuLstm,
 }
 
 impl Paper {
-    /// The four papers, in SPEC order.
+    /// The four papers, in the order of `docs/papers.md` (A to D).
     pub const ALL: [Paper; 4] = [Paper::Gskf, Paper::KfDynamic, Paper::Mkpf, Paper::KfuLstm];
 
     /// The slug used on the command line and as the results folder name.

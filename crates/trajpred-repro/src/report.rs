@@ -3,8 +3,8 @@
 //! and copied over it ([`replace_run`], `--bless`).
 //!
 //! Every number in a [`Table`] comes from a run, except the cells of [`ColumnKind::Paper`]
-//! columns, which hold the figure the paper itself reports (from SPEC), so that ours can be
-//! read beside it.
+//! columns, which hold the figure the paper itself reports (from `docs/papers.md`), so that ours
+//! can be read beside it.
 
 use crate::error::{ReproError, Result, io_err};
 use serde::{Deserialize, Serialize};

@@ -1,6 +1,6 @@
-//! The KF-dynamic paper's runner (SPEC B.4): without data, on tiny fixtures written here in
-//! the GeoLife and T-Drive formats, and (when `../shared/data` is present) on the real subset
-//! in quick mode.
+//! The KF-dynamic paper's runner (`docs/papers.md` B.4): without data, on tiny fixtures written
+//! here in the GeoLife and T-Drive formats, and (when `../shared/data` is present) on the real
+//! subset in quick mode.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

@@ -1,6 +1,6 @@
-//! The MKPF runner (SPEC C.2): the quick run writes its files with and without the ADS-B
-//! data, a table cell agrees with an independent computation, and the same seed gives the same
-//! tables.
+//! The MKPF runner (`docs/papers.md` C.2): the quick run writes its files with and without the
+//! ADS-B data, a table cell agrees with an independent computation, and the same seed gives the
+//! same tables.
 
 use std::path::PathBuf;
 use trajpred_repro::papers::mkpf::experiment::{

@@ -1,5 +1,5 @@
-//! Group sparse coding (SPEC A.3, eq. 4 and 14-16 of the GSKF paper): one LARS model per
-//! horizon `t = 1..T` on the Hankel design of a series, stacked into the coefficient matrix
+//! Group sparse coding (`docs/papers.md` A.3, eq. 4 and 14-16 of the GSKF paper): one LARS model
+//! per horizon `t = 1..T` on the Hankel design of a series, stacked into the coefficient matrix
 //! `A` (T x m) and the intercepts `b`, so that the multi-step prediction from a window `w` is
 //! `X_hat = A w + b` (eq. 19 with intercepts).
 

@@ -97,8 +97,8 @@ pub enum StopReason {
 /// Builder of a LARS fit; validates its parameters and the data in [`LarsParams::fit`].
 ///
 /// Defaults: [`Method::Lar`], intercept fitted, columns centred and scaled to unit L2 norm
-/// (SPEC A.2), full path, `alpha_min = 0`, tie tolerance `1e-12`, collinearity tolerance
-/// `1e-12`, vanishing-correlation tolerance `1e-12`.
+/// (`docs/papers.md` A.2), full path, `alpha_min = 0`, tie tolerance `1e-12`, collinearity
+/// tolerance `1e-12`, vanishing-correlation tolerance `1e-12`.
 ///
 /// ```
 /// use nalgebra::DMatrix;

@@ -2,7 +2,7 @@
 //!
 //! Least angle regression (LAR) and its lasso modification (Efron, Hastie, Johnstone and
 //! Tibshirani, *Least angle regression*, Ann. Statist. 32(2), 2004), and the group sparse
-//! coding of the MSTPM-GSKF paper (SPEC A.2, A.3), usable on their own.
+//! coding of the MSTPM-GSKF paper (`docs/papers.md` A.2, A.3), usable on their own.
 //!
 //! - [`Lars`]: the whole path (knots, alphas, active order, coefficients at every knot) from a
 //!   validating builder, `Lars::params().method(Method::Lasso).max_steps(20).fit(&x, &y)?`;
@@ -11,7 +11,7 @@
 //!
 //! ## The algorithm
 //!
-//! Preprocessing (SPEC A.2, both optional): centre `y` and every column of `X` (the
+//! Preprocessing (`docs/papers.md` A.2, both optional): centre `y` and every column of `X` (the
 //! intercept), and scale every column to unit L2 norm. Constant columns are excluded
 //! ([`ExclusionReason::ZeroVariance`]). On the standardised problem, with `beta = 0`,
 //! residual `r = y` and correlations `c = X^T r`:

@@ -22,9 +22,9 @@ fn eq20() -> [Vec<f64>; 3] {
 
 #[test]
 fn noise_free_eq20_is_predicted_exactly_for_every_horizon() {
-    // SPEC A.5: each axis is a sum of sinusoids, an exact linear recurrence of order 2 (x) or
-    // 4 (y, z), so with m = 6 a full path predicts the test part to rounding error. The bound
-    // 1e-9 m is the issue's; the values are O(1) m.
+    // `docs/papers.md` A.5: each axis is a sum of sinusoids, an exact linear recurrence of order 2
+    // (x) or 4 (y, z), so with m = 6 a full path predicts the test part to rounding error. The
+    // bound 1e-9 m is the issue's; the values are O(1) m.
     let (m, horizons) = (6, 6);
     for (axis, series) in eq20().iter().enumerate() {
         let gsc = GroupSparseCoder::params(m, horizons)

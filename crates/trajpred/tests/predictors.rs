@@ -119,8 +119,8 @@ fn kf_dynamic_and_naive_kf_extrapolate_uniform_motion() {
 }
 
 /// Eq. 20 of the GSKF paper without noise is a sum of sinusoids, which a linear recurrence of
-/// order <= 4 reproduces exactly (SPEC A.5): with m = 6 both GSC and GSKF predict the test
-/// part to rounding error.
+/// order <= 4 reproduces exactly (`docs/papers.md` A.5): with m = 6 both GSC and GSKF predict the
+/// test part to rounding error.
 #[test]
 fn gsc_and_gskf_are_exact_on_noiseless_eq20() {
     let tr = trajpred_data::synthetic::gskf_eq20();

@@ -1,4 +1,4 @@
-//! MSTPM-GSKF (SPEC A.5): group sparse coding + an improved Kalman filter on the eq. 20
+//! MSTPM-GSKF (`docs/papers.md` A.5): group sparse coding + an improved Kalman filter on the eq. 20
 //! trajectory.
 //!
 //! Setup: eq. 20, 1000 points, the first 800 train every model, the last 200 are the test
@@ -38,9 +38,9 @@ nothing toward the paper's numbers. The noise experiment (Fig. 4) is where the m
 separate. BP and LSTM are trained with the paper's plain gradient descent at learning rate 0.1; \
 their numbers depend on initialisation and float summation order.";
 
-/// Points of the trajectory used for training (SPEC A.5).
+/// Points of the trajectory used for training (`docs/papers.md` A.5).
 pub const TRAIN_POINTS: usize = 800;
-/// Test points at the end of the trajectory (SPEC A.5).
+/// Test points at the end of the trajectory (`docs/papers.md` A.5).
 pub const TEST_POINTS: usize = 200;
 
 /// Paper, Table 1: RMSE (1e-3 m) at T = 1 for m = 2..8.

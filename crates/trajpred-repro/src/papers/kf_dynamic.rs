@@ -1,5 +1,5 @@
 //! Dynamic trajectory prediction with a Kalman filter (Qiao et al., Acta Electronica Sinica
-//! 46(2), 2018; SPEC B.4).
+//! 46(2), 2018; `docs/papers.md` B.4).
 //!
 //! On GeoLife and on T-Drive (each read from [`Context::data`]; when one is absent its
 //! experiments are listed in [`PaperResult::missing`] and the rest still runs):

@@ -1,5 +1,5 @@
-//! The KFU-LSTM-Net patent (SPEC D.2): one-step-ahead prediction from noisy observations on
-//! three simulated 3-D curves and one real flight, RNN and LSTM against the
+//! The KFU-LSTM-Net patent (`docs/papers.md` D.2): one-step-ahead prediction from noisy
+//! observations on three simulated 3-D curves and one real flight, RNN and LSTM against the
 //! Kalman-filter-unfolded LSTM, scored against the clean truth.
 //!
 //! The experiment (written up with the equations in `docs/kfu-lstm.md`):

@@ -1,4 +1,4 @@
-//! MKPF (SPEC C.2): keep one frame in every 50 of a real flight, predict the frames in
+//! MKPF (`docs/papers.md` C.2): keep one frame in every 50 of a real flight, predict the frames in
 //! between from the kept ones only, and compare with the true frames by the paper's relative
 //! error `sqrt(mean(((x_hat - x) / x)^2))` on geodetic coordinates (the paper: 0.03% for the
 //! MKPF) and in metres. Compared: the MKPF, the bootstrap PF with the same particle count
@@ -27,7 +27,7 @@ noise levels, a process noise chosen by likelihood on the kept frames only, and 
 error in metres beside it, because the relative error on latitude and longitude mostly \
 measures how far the aircraft is from the equator and the Greenwich meridian.";
 
-/// The paper's relative error of the MKPF, percent (SPEC C.2).
+/// The paper's relative error of the MKPF, percent (`docs/papers.md` C.2).
 const PAPER_RELATIVE_ERROR_PCT: f64 = 0.03;
 
 /// Particles of the MKPF and of the bootstrap PF it is compared with.

@@ -1,5 +1,5 @@
 //! Group sparse coding ([`Gsc`]) and MSTPM-GSKF ([`Gskf`]): the multi-step predictor of the
-//! GSKF paper (SPEC A.3-A.4), per axis.
+//! GSKF paper (`docs/papers.md` A.3-A.4), per axis.
 //!
 //! GSC: for each axis, the T horizon models `x_hat_{i+t} = A[t] . w_i + b[t]` fitted by LAR on
 //! the Hankel designs of the training series (`trajpred-sparse`).
@@ -132,7 +132,7 @@ impl AxisFilter {
     fn new(gsc: GroupSparseCoder, q: f64) -> Result<Self> {
         let (m, t) = (gsc.window(), gsc.horizons());
         // F: the T predicted rows and columns of the m x m matrix of eq. 17-19 (for T <= m,
-        // the last T columns of A); identity when T > m (SPEC A.4)
+        // the last T columns of A); identity when T > m (`docs/papers.md` A.4)
         let f = if t <= m {
             gsc.coefficients().columns(m - t, t).into_owned()
         } else {
@@ -219,7 +219,7 @@ fn in_sample_error(filter: &AxisFilter, series: &[&[f64]]) -> Result<f64> {
     Ok(if n > 0 { sum / n as f64 } else { f64::INFINITY })
 }
 
-/// Group sparse coding alone (SPEC A.3): per axis, `X_hat = A w + b`.
+/// Group sparse coding alone (`docs/papers.md` A.3): per axis, `X_hat = A w + b`.
 ///
 /// ```
 /// use trajpred::predictors::{Gsc, GskfParams};
@@ -342,7 +342,7 @@ impl Predictor for Gsc {
     }
 }
 
-/// MSTPM-GSKF (SPEC A.4): GSC corrected by the improved one-step-ahead Kalman filter.
+/// MSTPM-GSKF (`docs/papers.md` A.4): GSC corrected by the improved one-step-ahead Kalman filter.
 ///
 /// `fit` fits the GSC per axis, sets `R` to the diagonal of the GSC training residual
 /// variances, and `Q = q I` with `q` chosen on the training series when not given. The

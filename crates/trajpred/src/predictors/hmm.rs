@@ -1,4 +1,4 @@
-//! The HMM motion-state predictor of SPEC B.2 (the KF-dynamic paper's "HMM" baseline).
+//! The HMM motion-state predictor of `docs/papers.md` B.2 (the KF-dynamic paper's "HMM" baseline).
 //!
 //! Training displacement vectors are clustered into K motion states by k-means; the states of
 //! consecutive displacements give a transition matrix by counting (observed states, Laplace
@@ -54,7 +54,8 @@ pub struct HmmModel {
     pub emission_variance: f64,
 }
 
-/// HMM motion-state predictor (SPEC B.2). Assumes a uniform sampling step (resample first).
+/// HMM motion-state predictor (`docs/papers.md` B.2). Assumes a uniform sampling step (resample
+/// first).
 ///
 /// ```
 /// use trajpred::predictors::{Hmm, HmmParams};

@@ -1,4 +1,4 @@
-//! Particle-filter predictors (SPEC C): the bootstrap particle filter and the MKPF
+//! Particle-filter predictors (`docs/papers.md` C): the bootstrap particle filter and the MKPF
 //! (UKF + EKF proposal), with a constant-velocity model and position observations.
 
 use super::{invalid, positions_forecast, step_interval};
@@ -20,7 +20,7 @@ use trajpred_particle::{Mkpf, ParticleFilter};
 pub enum ParticleKind {
     /// Bootstrap: propose from the transition.
     Bootstrap,
-    /// MKPF: per particle a UKF step then an EKF step give the proposal (SPEC C.1).
+    /// MKPF: per particle a UKF step then an EKF step give the proposal (`docs/papers.md` C.1).
     Mkpf,
 }
 

@@ -1,4 +1,4 @@
-//! N-point polynomial extrapolation (SPEC B.2): the KF-dynamic paper's "N-point linear
+//! N-point polynomial extrapolation (`docs/papers.md` B.2): the KF-dynamic paper's "N-point linear
 //! approximation" (degree 1) and "N-point quadratic fitting" (degree 2).
 
 use super::{invalid, step_interval};

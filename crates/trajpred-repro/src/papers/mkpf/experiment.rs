@@ -1,4 +1,4 @@
-//! The MKPF experiment (SPEC C.2) as functions the runner and the tests share: a flight
+//! The MKPF experiment (`docs/papers.md` C.2) as functions the runner and the tests share: a flight
 //! (observed and true frames, geodetic), the choice of the process noise from the kept frames,
 //! and one filter run that keeps one frame in every `keep_every`, updates at each kept frame
 //! and predicts every frame in between from the kept ones only.
