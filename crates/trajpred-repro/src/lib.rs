@@ -67,11 +67,13 @@ impl Paper {
     pub fn title(self) -> &'static str {
         match self {
             Paper::Gskf => {
-                "MSTPM-GSKF: multi-step prediction by group sparse coding and an improved Kalman filter (SPEC A)"
+                "MSTPM-GSKF: multi-step prediction by group sparse coding and an improved Kalman filter (docs/papers.md A)"
             }
-            Paper::KfDynamic => "Dynamic trajectory prediction with a Kalman filter (SPEC B)",
-            Paper::Mkpf => "MKPF: a particle filter with a UKF+EKF proposal (SPEC C)",
-            Paper::KfuLstm => "KFU-LSTM-Net: a Kalman-filter-unfolded LSTM (SPEC D)",
+            Paper::KfDynamic => {
+                "Dynamic trajectory prediction with a Kalman filter (docs/papers.md B)"
+            }
+            Paper::Mkpf => "MKPF: a particle filter with a UKF+EKF proposal (docs/papers.md C)",
+            Paper::KfuLstm => "KFU-LSTM-Net: a Kalman-filter-unfolded LSTM (docs/papers.md D)",
         }
     }
 

@@ -17,41 +17,7 @@ const WORD: &str = concat!("SP", "EC");
 /// line): strings the reproduction writes into `docs/results/`, where changing them would make
 /// the committed output differ from a fresh run. Remove an entry when its string is changed and
 /// the results are regenerated.
-const PENDING: &[(&str, &str)] = &[
-    (
-        "crates/trajpred-repro/src/lib.rs",
-        "group sparse coding and an improved Kalman filter (",
-    ),
-    (
-        "crates/trajpred-repro/src/lib.rs",
-        "\"Dynamic trajectory prediction with a Kalman filter (",
-    ),
-    (
-        "crates/trajpred-repro/src/lib.rs",
-        "\"MKPF: a particle filter with a UKF+EKF proposal (",
-    ),
-    (
-        "crates/trajpred-repro/src/lib.rs",
-        "\"KFU-LSTM-Net: a Kalman-filter-unfolded LSTM (",
-    ),
-    ("crates/trajpred-repro/src/papers/gskf.rs", "\"Q and R ("),
-    (
-        "crates/trajpred-repro/src/papers/gskf.rs",
-        "(noise on the test data only, ",
-    ),
-    (
-        "crates/trajpred-repro/src/papers/kfu_lstm.rs",
-        "KFU-LSTM-Net is trained against the clean truth as ",
-    ),
-    (
-        "crates/trajpred-repro/src/papers/kfu_lstm.rs",
-        "\"Curves (the patent's equations are missing; ",
-    ),
-    (
-        "crates/trajpred-repro/src/papers/kfu_lstm.rs",
-        "in z-scored units (",
-    ),
-];
+const PENDING: &[(&str, &str)] = &[];
 
 /// Text files worth reading; everything else (binary fixtures, images) is skipped.
 const EXTENSIONS: &[&str] = &[

@@ -901,7 +901,7 @@ pub fn run(ctx: &Context) -> Result<PaperResult> {
             .to_string(),
     );
     result.notes.push(format!(
-        "Q and R (SPEC A.4, docs/gskf.md): R is the diagonal of the GSC training residual \
+        "Q and R (docs/papers.md A.4, docs/gskf.md): R is the diagonal of the GSC training residual \
          variances per horizon; Q = q I with q = g * mean(R), g chosen from {{1e-4, ..., 100}} \
          by the GSKF's mean squared error over the rolling origins of the training part only. \
          On noiseless training data R is at rounding level, so the filter's gain is set by \
@@ -914,7 +914,7 @@ pub fn run(ctx: &Context) -> Result<PaperResult> {
     ));
     let norms = coefficient_norms(&train)?;
     result.notes.push(format!(
-        "Fig. 4, the paper's setup (noise on the test data only, SPEC A.5): the models are \
+        "Fig. 4, the paper's setup (noise on the test data only, docs/papers.md A.5): the models are \
          those of Table 3, fitted on the clean training part, so GSC is the exact recurrence of \
          the noiseless curve. That recurrence is badly conditioned: the windows of the slowly \
          turning curve are nearly collinear and the fitted coefficients are large, so white \

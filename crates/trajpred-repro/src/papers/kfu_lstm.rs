@@ -45,7 +45,7 @@ figure-eight, climbing spiral with a turn onto a level leg), the noise level, th
 window, the epoch counts and the baselines' window length are ours, so only the ranking can be \
 compared with the patent's claim. Training is shortened to fit the run-time budget (KFU at \
 learning rate 1e-3 rather than 1e-4), F is the identity, and the baselines learn from noisy \
-targets while the KFU-LSTM-Net is trained against the clean truth as SPEC decides.";
+targets while the KFU-LSTM-Net is trained against the clean truth, as decided in docs/papers.md D.";
 
 /// Standard deviation (m) of the Gaussian noise on every axis of the simulated curves.
 pub const CURVE_SIGMA: f64 = 0.5;
@@ -590,7 +590,7 @@ pub fn run(ctx: &Context) -> Result<PaperResult> {
     );
 
     result.notes.extend([
-        "Curves (the patent's equations are missing; SPEC D.2 decided the shapes): helix \
+        "Curves (the patent's equations are missing; docs/papers.md D.2 states the shapes we chose): helix \
          x = 10 cos 0.2t, y = 10 sin 0.2t, z = 0.5t; Lissajous figure-eight x = 20 sin ωt, \
          y = 10 sin 2ωt, z = 5 sin 3ωt with ω = 2π/100; climbing spiral of radius 20 m at \
          0.25 rad/s climbing 1 m/s that rolls out at t = 60 s onto a level straight leg at 5 m/s. \
@@ -618,7 +618,7 @@ pub fn run(ctx: &Context) -> Result<PaperResult> {
         "F = the identity in P(t|t-1) = F P F^T + Q (the neural crate's choice: burn cannot \
          take the LSTM's Jacobian cheaply inside the unrolled graph); Q and R diagonal, \
          positive through log parameters; the transition is residual, y(t|t-1) = y + f(y). \
-         Loss MSE(y(t|t), truth) + 0.5 MSE(y(t|t-1), truth) in z-scored units (SPEC D.1)."
+         Loss MSE(y(t|t), truth) + 0.5 MSE(y(t|t-1), truth) in z-scored units (docs/papers.md D.1)."
             .to_string(),
         "The KFU-LSTM-Net is trained against the clean truth of its training part (the \
          patent's supervised setting); the RNN and LSTM window baselines can only learn from \
