@@ -3,20 +3,22 @@
 // a command-line tool writes its results to standard output
 #![allow(clippy::print_stdout)]
 
-use anyhow::{Context, Result, anyhow, bail};
+mod output;
+mod progress;
+
+use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
-use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::{IsTerminal, Write};
+use output::{Format, table, write_atomic, write_forecast};
+use progress::Bars;
 use std::path::PathBuf;
 use trajpred::dataset::{self, Dataset, Loaded, Segment, Segmentation};
 use trajpred::harness::{MethodReport, Split};
 use trajpred::plot::{Chart, Series, write_chart};
-use trajpred::protocol::{self, MethodSpec, Progress, Protocol};
+use trajpred::protocol::{self, MethodSpec, Protocol};
 use trajpred::registry::{MethodOptions, all_methods, build};
 use trajpred_core::MAX_HORIZON;
 use trajpred_core::{Forecast, Trajectory};
-use trajpred_data::geodesy::{Enu, LocalFrame};
-use trajpred_data::{Frame, LoadOptions};
+use trajpred_data::LoadOptions;
 
 #[derive(Parser)]
 #[command(
@@ -27,13 +29,6 @@ use trajpred_data::{Frame, LoadOptions};
 struct Cli {
     #[command(subcommand)]
     command: Command,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum Format {
-    Markdown,
-    Csv,
-    Json,
 }
 
 /// Segmentation options, applied right after loading (before anything else).
@@ -299,240 +294,6 @@ fn last_points(tr: &Trajectory, history: Option<usize>) -> Result<Trajectory> {
     }
 }
 
-/// The forecast's step in seconds: the mean interval of the history, as the methods take it.
-fn mean_interval(tr: &Trajectory) -> f64 {
-    let t = tr.times();
-    if t.len() < 2 {
-        return 1.0;
-    }
-    (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64
-}
-
-/// Latitude and longitude of a point of an ENU frame.
-fn lat_lon(frame: Option<&LocalFrame>, p: &[f64]) -> Option<(f64, f64)> {
-    let g = frame?.to_geodetic(&Enu {
-        east: p[0],
-        north: p.get(1).copied().unwrap_or(0.0),
-        up: p.get(2).copied().unwrap_or(0.0),
-    });
-    Some((g.lat_deg, g.lon_deg))
-}
-
-fn write_forecast(
-    f: &Forecast,
-    seg: &Segment,
-    history: &Trajectory,
-    format: Format,
-    out: &mut dyn Write,
-) -> Result<()> {
-    let dt = mean_interval(history);
-    let t_last = history.times()[history.len() - 1];
-    let times: Vec<f64> = (1..=f.horizon()).map(|k| t_last + dt * k as f64).collect();
-    let axes = ["x", "y", "z"];
-    let origin = match seg.frame {
-        Frame::Enu(o) => Some(o),
-        _ => None,
-    };
-    let local = origin.map(LocalFrame::new).transpose()?;
-    let frame = match origin {
-        Some(o) => format!(
-            "local east/north metres around lat {:.7} lon {:.7}",
-            o.lat_deg, o.lon_deg
-        ),
-        None => "the input's own metres".to_string(),
-    };
-    match format {
-        Format::Json => {
-            let steps: Vec<serde_json::Value> = f
-                .points()
-                .zip(&times)
-                .enumerate()
-                .map(|(k, (p, t))| {
-                    let ll = lat_lon(local.as_ref(), &p);
-                    serde_json::json!({
-                        "step": k + 1,
-                        "t": t,
-                        "point": p.to_vec(),
-                        "lat_deg": ll.map(|v| v.0),
-                        "lon_deg": ll.map(|v| v.1),
-                        "covariance": f.covariance(k + 1).map(|c| {
-                            c.row_iter().map(|r| r.iter().copied().collect::<Vec<f64>>())
-                                .collect::<Vec<_>>()
-                        }),
-                    })
-                })
-                .collect();
-            let doc = serde_json::json!({
-                "segment": seg.id,
-                "origin_time": t_last,
-                "step_seconds": dt,
-                "dim": f.dim(),
-                "frame": match origin {
-                    Some(o) => serde_json::json!({
-                        "kind": "enu",
-                        "origin_lat_deg": o.lat_deg,
-                        "origin_lon_deg": o.lon_deg,
-                        "origin_alt_m": o.alt_m,
-                    }),
-                    None => serde_json::json!({ "kind": "cartesian" }),
-                },
-                "steps": steps,
-            });
-            writeln!(out, "{}", serde_json::to_string_pretty(&doc)?)?;
-        }
-        Format::Csv | Format::Markdown => {
-            let md = matches!(format, Format::Markdown);
-            let mut header: Vec<&str> = axes[..f.dim()].to_vec();
-            if local.is_some() {
-                header.extend(["lat", "lon"]);
-            }
-            if md {
-                writeln!(
-                    out,
-                    "Forecast of {} from t = {t_last} s, steps of {dt:.3} s (the history's mean \
-                     interval), in {frame}.\n",
-                    seg.id
-                )?;
-                writeln!(out, "| step | t | {} |", header.join(" | "))?;
-                writeln!(out, "|---|---|{}", "---|".repeat(header.len()))?;
-            } else {
-                eprintln!(
-                    "note: the forecast is in {frame}; steps of {dt} s (the history's mean interval)"
-                );
-                writeln!(out, "step,t,{}", header.join(","))?;
-            }
-            for (k, (p, t)) in f.points().zip(&times).enumerate() {
-                let mut vals: Vec<String> = p.iter().map(|v| format!("{v:.6}")).collect();
-                if let Some((lat, lon)) = lat_lon(local.as_ref(), &p) {
-                    vals.extend([format!("{lat:.8}"), format!("{lon:.8}")]);
-                }
-                if md {
-                    writeln!(out, "| {} | {t} | {} |", k + 1, vals.join(" | "))?;
-                } else {
-                    writeln!(out, "{},{t},{}", k + 1, vals.join(","))?;
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Progress bars on stderr (none when stderr is not a terminal, or with `--quiet`).
-struct Bars {
-    multi: MultiProgress,
-    current: std::sync::Mutex<Option<ProgressBar>>,
-    style: ProgressStyle,
-}
-
-impl Bars {
-    fn new(quiet: bool) -> Result<Self> {
-        let target = if quiet || !std::io::stderr().is_terminal() {
-            ProgressDrawTarget::hidden()
-        } else {
-            ProgressDrawTarget::stderr()
-        };
-        Ok(Bars {
-            multi: MultiProgress::with_draw_target(target),
-            current: std::sync::Mutex::new(None),
-            style: ProgressStyle::with_template("{prefix:>24} {bar:30} {pos}/{len} {elapsed}")
-                .map_err(|e| anyhow!("{e}"))?,
-        })
-    }
-
-    fn spinner(&self, message: String) -> ProgressBar {
-        let s = self
-            .multi
-            .add(ProgressBar::new_spinner().with_message(message));
-        s.enable_steady_tick(std::time::Duration::from_millis(120));
-        s
-    }
-}
-
-impl Progress for Bars {
-    fn start(&self, stage: &str, total: u64) {
-        let bar = self.multi.add(ProgressBar::new(total));
-        bar.set_style(self.style.clone());
-        bar.set_prefix(stage.to_string());
-        if let Ok(mut c) = self.current.lock() {
-            *c = Some(bar);
-        }
-    }
-    fn advance(&self, n: u64) {
-        if let Ok(c) = self.current.lock()
-            && let Some(b) = c.as_ref()
-        {
-            b.inc(n);
-        }
-    }
-    fn finish(&self) {
-        if let Ok(mut c) = self.current.lock()
-            && let Some(b) = c.take()
-        {
-            b.finish();
-        }
-    }
-}
-
-fn table(reports: &[MethodReport], format: Format) -> Result<String> {
-    if let Format::Json = format {
-        return Ok(serde_json::to_string_pretty(reports)?);
-    }
-    let h = reports.first().map_or(0, |r| r.mean_euclidean.len());
-    let mut head = vec![
-        "method".to_string(),
-        "trajectories".into(),
-        "forecasts".into(),
-        "failures".into(),
-    ];
-    for k in 1..=h {
-        head.push(format!("mean err step {k} (m)"));
-    }
-    head.extend([
-        "mean err all (m)".into(),
-        "hit rate all".into(),
-        "fit (s)".into(),
-        "forecast (s)".into(),
-    ]);
-    let rows: Vec<Vec<String>> = reports
-        .iter()
-        .map(|r| {
-            let mut row = vec![
-                r.method.clone(),
-                r.trajectories.to_string(),
-                r.forecasts.to_string(),
-                r.failures.to_string(),
-            ];
-            row.extend(r.mean_euclidean.iter().map(|v| format!("{v:.3}")));
-            row.extend([
-                format!("{:.3}", r.mean_euclidean_all),
-                format!("{:.4}", r.hit_rate_all),
-                format!("{:.3}", r.fit_seconds),
-                format!("{:.3}", r.forecast_seconds),
-            ]);
-            row
-        })
-        .collect();
-    let mut s = String::new();
-    match format {
-        Format::Csv => {
-            s.push_str(&head.join(","));
-            s.push('\n');
-            for r in rows {
-                s.push_str(&r.join(","));
-                s.push('\n');
-            }
-        }
-        _ => {
-            s.push_str(&format!("| {} |\n", head.join(" | ")));
-            s.push_str(&format!("|{}\n", "---|".repeat(head.len())));
-            for r in rows {
-                s.push_str(&format!("| {} |\n", r.join(" | ")));
-            }
-        }
-    }
-    Ok(s)
-}
-
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Methods => {
@@ -795,22 +556,6 @@ fn run(cli: Cli) -> Result<()> {
             eprintln!("wrote {}", output.display());
         }
     }
-    Ok(())
-}
-
-/// Writes `bytes` to `path` through a temporary file in the same folder, then renames it.
-fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(std::path::Path::new("."));
-    let name = path
-        .file_name()
-        .context("the output path names no file")?
-        .to_string_lossy();
-    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
-    std::fs::write(&tmp, bytes).with_context(|| format!("cannot write {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("cannot write {}", path.display()))?;
     Ok(())
 }
 
