@@ -3,6 +3,8 @@
 //! `blockdiag(P, Q, R)`, propagated through `f(x, w)` and then `h(f(x, w), v)`, so noise that
 //! enters the models non-additively is handled exactly as the paper does.
 
+use crate::alloc::FilterAllocator;
+use crate::driver::scan;
 use crate::error::Result;
 use crate::filter::{InputChecks, Step, Update, validate_state};
 use crate::linalg::{check_dim, check_finite, ldl, symmetrise};
@@ -129,12 +131,7 @@ impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
         M: Dim,
         Tr: NoisyTransition<T, D>,
         Ob: NoisyObservation<T, D, M>,
-        DefaultAllocator: Allocator<D>
-            + Allocator<D, D>
-            + Allocator<M>
-            + Allocator<M, M>
-            + Allocator<D, M>
-            + Allocator<M, D>,
+        DefaultAllocator: FilterAllocator<D, M>,
     {
         let (tr, ob) = (&self.transition, &self.observation);
         let n = tr.state_dim();
@@ -230,12 +227,7 @@ impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
         M: Dim,
         Tr: NoisyTransition<T, D>,
         Ob: NoisyObservation<T, D, M>,
-        DefaultAllocator: Allocator<D>
-            + Allocator<D, D>
-            + Allocator<M>
-            + Allocator<M, M>
-            + Allocator<D, M>
-            + Allocator<M, D>,
+        DefaultAllocator: FilterAllocator<D, M>,
     {
         Ok(self.moments::<D, M>(state)?.prior)
     }
@@ -252,12 +244,7 @@ impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
         M: Dim,
         Tr: NoisyTransition<T, D>,
         Ob: NoisyObservation<T, D, M>,
-        DefaultAllocator: Allocator<D>
-            + Allocator<D, D>
-            + Allocator<M>
-            + Allocator<M, M>
-            + Allocator<D, M>
-            + Allocator<M, D>,
+        DefaultAllocator: FilterAllocator<D, M>,
     {
         let mo = self.moments::<D, M>(state)?;
         let Some(z) = z else {
@@ -305,21 +292,10 @@ impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
         M: Dim,
         Tr: NoisyTransition<T, D>,
         Ob: NoisyObservation<T, D, M>,
-        DefaultAllocator: Allocator<D>
-            + Allocator<D, D>
-            + Allocator<M>
-            + Allocator<M, M>
-            + Allocator<D, M>
-            + Allocator<M, D>,
+        DefaultAllocator: FilterAllocator<D, M>,
     {
-        let mut out: Vec<Step<T, D, M>> = Vec::with_capacity(observations.len());
-        for z in observations {
-            let step = match out.last() {
-                Some(prev) => self.step(prev.posterior(), z.as_ref())?,
-                None => self.step(initial, z.as_ref())?,
-            };
-            out.push(step);
-        }
-        Ok(out)
+        scan(observations, |prev: Option<&Step<T, D, M>>, z| {
+            self.step(prev.map_or(initial, Step::posterior), z.as_ref())
+        })
     }
 }

@@ -39,6 +39,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+use crate::alloc::FilterAllocator;
 use crate::error::{KalmanError, Result};
 use crate::filter::Filter;
 use nalgebra::allocator::Allocator;
@@ -78,7 +79,33 @@ pub fn check_dt<T: RealField + Copy>(dt: T, what: &'static str) -> Result<()> {
     }
 }
 
-/// The one loop: the filter's estimate is at `times[0]`; for each later time it advances by
+/// The one recursion behind every run of a trajpred filter over a sequence: `step` is called
+/// for each input in order with the output of the previous call (`None` for the first), and
+/// the outputs are collected; the first error stops the run. [`drive`],
+/// [`Filter::filter`](crate::Filter::filter), [`Filter::forecast`](crate::Filter::forecast),
+/// the IKF, the augmented UKF and the predictor form all run through it.
+///
+/// ```
+/// use trajpred_kalman::driver::scan;
+/// // running sums
+/// let sums = scan([1, 2, 3], |prev: Option<&i32>, x| Ok::<_, ()>(prev.copied().unwrap_or(0) + x));
+/// assert_eq!(sums, Ok(vec![1, 3, 6]));
+/// ```
+pub fn scan<I, S, E, F>(inputs: I, mut step: F) -> std::result::Result<Vec<S>, E>
+where
+    I: IntoIterator,
+    F: FnMut(Option<&S>, I::Item) -> std::result::Result<S, E>,
+{
+    let inputs = inputs.into_iter();
+    let mut out: Vec<S> = Vec::with_capacity(inputs.size_hint().0);
+    for input in inputs {
+        let next = step(out.last(), input)?;
+        out.push(next);
+    }
+    Ok(out)
+}
+
+/// The driver's loop: the filter's estimate is at `times[0]`; for each later time it advances by
 /// the interval and updates with the observation there (`None`: missing), then calls
 /// `after(k, filter)` (for example to forecast from there). Returns the estimate after each
 /// time `times[1..]`. `observations[0]` is not used (the estimate at `times[0]` is the
@@ -105,15 +132,14 @@ where
         }
         .into());
     }
-    let mut out = Vec::with_capacity(times.len().saturating_sub(1));
-    for k in 1..times.len() {
+    scan(1..times.len(), |_, k| {
         let dt = times[k] - times[k - 1];
         check_dt(dt, "times")?;
         filter.advance(dt, observations[k].as_ref())?;
-        out.push(filter.estimate()?);
+        let estimate = filter.estimate()?;
         after(k, filter)?;
-    }
-    Ok(out)
+        Ok(estimate)
+    })
 }
 
 /// A Gaussian [`Filter`] run by time steps: `make(dt)` builds the filter (its transition and
@@ -165,12 +191,7 @@ where
     M: Dim,
     F: Filter<T, D, M>,
     Make: Fn(T) -> Result<F>,
-    DefaultAllocator: Allocator<D>
-        + Allocator<D, D>
-        + Allocator<M>
-        + Allocator<M, M>
-        + Allocator<D, M>
-        + Allocator<M, D>,
+    DefaultAllocator: FilterAllocator<D, M>,
 {
     type Error = KalmanError;
 

@@ -2,6 +2,8 @@
 //! k-step forecast, control input), the result types [`Update`] and [`Step`], the covariance
 //! update forms [`CovarianceUpdate`], and the RTS smoother [`Smoother`].
 
+use crate::alloc::FilterAllocator;
+use crate::driver::scan;
 use crate::error::{KalmanError, Result};
 use crate::linalg::{
     Ldl, all_finite, check_dim, check_finite, check_square, check_state, congruence_ldl, is_static,
@@ -164,12 +166,7 @@ where
 /// failures are typed [`KalmanError`]s.
 pub trait Filter<T: RealField + Copy, D: Dim, M: Dim>
 where
-    DefaultAllocator: Allocator<D>
-        + Allocator<D, D>
-        + Allocator<M>
-        + Allocator<M, M>
-        + Allocator<D, M>
-        + Allocator<M, D>,
+    DefaultAllocator: FilterAllocator<D, M>,
 {
     /// The prediction `N(x(k|k-1), P(k|k-1))` from the previous estimate.
     fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>>;
@@ -260,9 +257,8 @@ where
         initial: &Gaussian<T, D>,
         observations: &[Option<OVector<T, M>>],
     ) -> Result<Vec<Step<T, D, M>>> {
-        let mut out: Vec<Step<T, D, M>> = Vec::with_capacity(observations.len());
-        for z in observations {
-            let step = match (out.last(), z) {
+        scan(observations, |prev: Option<&Step<T, D, M>>, z| {
+            Ok(match (prev, z) {
                 (Some(prev), Some(z)) => {
                     let (prior, update) = self.predict_update(prev.posterior(), z, true)?;
                     Step {
@@ -275,10 +271,8 @@ where
                     update: None,
                 },
                 (None, z) => self.step(initial, z.as_ref())?,
-            };
-            out.push(step);
-        }
-        Ok(out)
+            })
+        })
     }
 
     /// The total log-likelihood `sum_k ln N(y_k; 0, S_k)` of a sequence (missing
@@ -297,15 +291,10 @@ where
     /// The forecast `N(x(k+j|k), P(k+j|k))` for `j = 1..=steps`: the prediction applied
     /// `steps` times without observations.
     fn forecast(&self, state: &Gaussian<T, D>, steps: usize) -> Result<Vec<Gaussian<T, D>>> {
-        let mut out: Vec<Gaussian<T, D>> = Vec::with_capacity(steps);
-        for _ in 0..steps {
-            let next = match out.last() {
-                Some(prev) => self.predict_own_output(prev)?,
-                None => self.predict(state)?,
-            };
-            out.push(next);
-        }
-        Ok(out)
+        scan(0..steps, |prev: Option<&Gaussian<T, D>>, _| match prev {
+            Some(prev) => self.predict_own_output(prev),
+            None => self.predict(state),
+        })
     }
 }
 
@@ -324,12 +313,7 @@ pub type PredictionWithCross<T, D> = (Gaussian<T, D>, OMatrix<T, D, D>);
 /// `x(k)` and `x(k+1)`.
 pub trait Smoother<T: RealField + Copy, D: Dim, M: Dim>: Filter<T, D, M>
 where
-    DefaultAllocator: Allocator<D>
-        + Allocator<D, D>
-        + Allocator<M>
-        + Allocator<M, M>
-        + Allocator<D, M>
-        + Allocator<M, D>,
+    DefaultAllocator: FilterAllocator<D, M>,
 {
     /// The prediction from `filtered` and the cross-covariance `C = Cov(x(k), x(k+1))`.
     fn prediction_with_cross_covariance(
@@ -552,12 +536,7 @@ where
     D: Dim,
     M: Dim,
     Ob: Observation<T, D, M> + ?Sized,
-    DefaultAllocator: Allocator<D>
-        + Allocator<D, D>
-        + Allocator<M>
-        + Allocator<M, M>
-        + Allocator<D, M>
-        + Allocator<M, D>,
+    DefaultAllocator: FilterAllocator<D, M>,
 {
     let n = prior.mean.nrows();
     let m = observation.observation_dim();
@@ -590,12 +569,7 @@ where
     D: Dim,
     M: Dim,
     Ob: Observation<T, D, M> + ?Sized,
-    DefaultAllocator: Allocator<D>
-        + Allocator<D, D>
-        + Allocator<M>
-        + Allocator<M, M>
-        + Allocator<D, M>
-        + Allocator<M, D>,
+    DefaultAllocator: FilterAllocator<D, M>,
 {
     let p = &prior.covariance;
     let factors = ldl(s.clone(), "S")?;

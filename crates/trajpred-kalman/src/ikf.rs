@@ -15,6 +15,8 @@
 //! `X(k|k)` is a corrected **one-step-ahead prediction** of time `k` made at time `k-1`,
 //! not a filtered estimate.
 
+use crate::alloc::FilterAllocator;
+use crate::driver::scan;
 use crate::error::Result;
 use crate::filter::{CovarianceUpdate, InputChecks, validate_state};
 use crate::linalg::{check_dim, check_finite, check_pd, ldl, symmetrise};
@@ -111,12 +113,7 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
         M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
-        DefaultAllocator: Allocator<D>
-            + Allocator<D, D>
-            + Allocator<M>
-            + Allocator<M, M>
-            + Allocator<M, D>
-            + Allocator<D, M>,
+        DefaultAllocator: FilterAllocator<D, M>,
     {
         validate_models(&transition, &observation)?;
         check_dim(
@@ -147,12 +144,7 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
         M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
-        DefaultAllocator: Allocator<D>
-            + Allocator<D, D>
-            + Allocator<M>
-            + Allocator<M, M>
-            + Allocator<M, D>
-            + Allocator<D, M>,
+        DefaultAllocator: FilterAllocator<D, M>,
     {
         let n = self.transition.state_dim();
         check_dim("P rows", n, p.nrows())?;
@@ -173,12 +165,7 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
         M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
-        DefaultAllocator: Allocator<D>
-            + Allocator<D, D>
-            + Allocator<M>
-            + Allocator<M, M>
-            + Allocator<M, D>
-            + Allocator<D, M>,
+        DefaultAllocator: FilterAllocator<D, M>,
     {
         validate_state(state, self.transition.state_dim(), InputChecks::Full)?;
         let covariance = self.propagate_covariance::<T, D, M>(&state.covariance)?;
@@ -199,12 +186,7 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
         M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
-        DefaultAllocator: Allocator<D>
-            + Allocator<D, D>
-            + Allocator<M>
-            + Allocator<M, M>
-            + Allocator<M, D>
-            + Allocator<D, M>,
+        DefaultAllocator: FilterAllocator<D, M>,
     {
         validate_state(prior, self.transition.state_dim(), InputChecks::Full)?;
         check_dim("observation", self.observation.observation_dim(), z.nrows())?;
@@ -230,12 +212,7 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
         M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
-        DefaultAllocator: Allocator<D>
-            + Allocator<D, D>
-            + Allocator<M>
-            + Allocator<M, M>
-            + Allocator<M, D>
-            + Allocator<D, M>,
+        DefaultAllocator: FilterAllocator<D, M>,
     {
         let n = self.transition.state_dim();
         validate_state(prior, n, InputChecks::Full)?;
@@ -287,12 +264,7 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
         M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
-        DefaultAllocator: Allocator<D>
-            + Allocator<D, D>
-            + Allocator<M>
-            + Allocator<M, M>
-            + Allocator<M, D>
-            + Allocator<D, M>,
+        DefaultAllocator: FilterAllocator<D, M>,
     {
         let prior = self.predict::<T, D, M>(state)?;
         let corrected = match previous {
@@ -324,23 +296,16 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
         M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
-        DefaultAllocator: Allocator<D>
-            + Allocator<D, D>
-            + Allocator<M>
-            + Allocator<M, M>
-            + Allocator<M, D>
-            + Allocator<D, M>,
+        DefaultAllocator: FilterAllocator<D, M>,
     {
-        let mut out: Vec<IkfStep<T, D, M>> = Vec::with_capacity(observations.len());
         let mut memory: Option<Innovation<T, M>> = None;
-        for z in observations {
-            let state = out.last().map_or(initial, |s| &s.corrected);
+        scan(observations, |prev: Option<&IkfStep<T, D, M>>, z| {
+            let state = prev.map_or(initial, |s| &s.corrected);
             let step = self.step(state, memory.as_ref(), z.as_ref())?;
             if let Some(v) = &step.innovation {
                 memory = Some(v.clone());
             }
-            out.push(step);
-        }
-        Ok(out)
+            Ok(step)
+        })
     }
 }

@@ -2,6 +2,7 @@
 //! predict/update code path, the KF with constant `F`, `H`, the EKF with `f`, `h` and their
 //! Jacobians evaluated at the current estimate.
 
+use crate::alloc::FilterAllocator;
 use crate::error::Result;
 use crate::filter::{
     CovarianceUpdate, Filter, InputChecks, PredictionAndUpdate, PredictionWithCross, Smoother,
@@ -129,12 +130,7 @@ where
     M: Dim,
     Tr: LinearTransitionModel<T, D>,
     Ob: LinearObservationModel<T, D, M>,
-    DefaultAllocator: Allocator<D>
-        + Allocator<D, D>
-        + Allocator<M>
-        + Allocator<M, M>
-        + Allocator<D, M>
-        + Allocator<M, D>,
+    DefaultAllocator: FilterAllocator<D, M>,
 {
     #[inline(always)]
     fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
@@ -254,12 +250,7 @@ where
     M: Dim,
     Tr: LinearTransitionModel<T, D>,
     Ob: LinearObservationModel<T, D, M>,
-    DefaultAllocator: Allocator<D>
-        + Allocator<D, D>
-        + Allocator<M>
-        + Allocator<M, M>
-        + Allocator<D, M>
-        + Allocator<M, D>,
+    DefaultAllocator: FilterAllocator<D, M>,
 {
     fn prediction_with_cross_covariance(
         &self,
@@ -336,12 +327,7 @@ where
     M: Dim,
     Tr: TransitionJacobian<T, D>,
     Ob: ObservationJacobian<T, D, M>,
-    DefaultAllocator: Allocator<D>
-        + Allocator<D, D>
-        + Allocator<M>
-        + Allocator<M, M>
-        + Allocator<D, M>
-        + Allocator<M, D>,
+    DefaultAllocator: FilterAllocator<D, M>,
 {
     fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
         validate_state(state, self.transition.state_dim(), self.checks)?;
@@ -395,12 +381,7 @@ where
     M: Dim,
     Tr: TransitionJacobian<T, D>,
     Ob: ObservationJacobian<T, D, M>,
-    DefaultAllocator: Allocator<D>
-        + Allocator<D, D>
-        + Allocator<M>
-        + Allocator<M, M>
-        + Allocator<D, M>
-        + Allocator<M, D>,
+    DefaultAllocator: FilterAllocator<D, M>,
 {
     fn prediction_with_cross_covariance(
         &self,

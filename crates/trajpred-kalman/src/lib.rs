@@ -101,6 +101,7 @@
 //! ```
 #![forbid(unsafe_code)]
 
+mod alloc;
 pub mod driver;
 pub mod error;
 pub mod filter;
@@ -108,6 +109,7 @@ pub mod kf;
 mod linalg;
 pub mod model;
 
+pub use alloc::FilterAllocator;
 pub use error::{KalmanError, Result};
 pub use filter::{
     CovarianceUpdate, Filter, InputChecks, PredictionAndUpdate, PredictionWithCross, Smoother,

@@ -11,12 +11,13 @@
 //! KF written as one recursion on the one-step-ahead prediction; it equals
 //! [`Filter::update`] with the plain covariance form followed by [`Filter::predict`].
 
+use crate::alloc::FilterAllocator;
+use crate::driver::scan;
 use crate::error::Result;
 use crate::filter::{Filter, InputChecks, validate_state};
 use crate::kf::Kf;
 use crate::linalg::{check_dim, check_finite, ldl, symmetrise};
 use crate::model::{LinearObservationModel, LinearTransitionModel};
-use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OVector, RealField};
 use trajpred_core::Gaussian;
 
@@ -60,12 +61,7 @@ impl<Tr, Ob> Kf<Tr, Ob> {
         M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
-        DefaultAllocator: Allocator<D>
-            + Allocator<D, D>
-            + Allocator<M>
-            + Allocator<M, M>
-            + Allocator<D, M>
-            + Allocator<M, D>,
+        DefaultAllocator: FilterAllocator<D, M>,
     {
         let Some(z) = z else {
             return self.predict(prediction);
@@ -112,20 +108,11 @@ impl<Tr, Ob> Kf<Tr, Ob> {
         M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
-        DefaultAllocator: Allocator<D>
-            + Allocator<D, D>
-            + Allocator<M>
-            + Allocator<M, M>
-            + Allocator<D, M>
-            + Allocator<M, D>,
+        DefaultAllocator: FilterAllocator<D, M>,
     {
-        let mut out: Vec<Gaussian<T, D>> = Vec::with_capacity(observations.len());
-        for z in observations {
-            let current = out.last().unwrap_or(first_prediction);
-            let next = self.predictor_step(current, z.as_ref())?;
-            out.push(next);
-        }
-        Ok(out)
+        scan(observations, |prev: Option<&Gaussian<T, D>>, z| {
+            self.predictor_step(prev.unwrap_or(first_prediction), z.as_ref())
+        })
     }
 
     /// The `steps`-step forecast `N(X(k+j|k), P(k+j|k))`, `j = 1..=steps`, from the
@@ -144,23 +131,15 @@ impl<Tr, Ob> Kf<Tr, Ob> {
         M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
-        DefaultAllocator: Allocator<D>
-            + Allocator<D, D>
-            + Allocator<M>
-            + Allocator<M, M>
-            + Allocator<D, M>
-            + Allocator<M, D>,
+        DefaultAllocator: FilterAllocator<D, M>,
     {
-        let mut out: Vec<Gaussian<T, D>> = Vec::with_capacity(steps);
-        for j in 0..steps {
-            let current = out.last().unwrap_or(prediction);
-            let next = if j == 0 || mode == MultiStep::ReuseLastObservation {
-                self.predictor_step(current, Some(last_observation))?
+        scan(0..steps, |prev: Option<&Gaussian<T, D>>, j| {
+            let current = prev.unwrap_or(prediction);
+            if j == 0 || mode == MultiStep::ReuseLastObservation {
+                self.predictor_step(current, Some(last_observation))
             } else {
-                self.predict(current)?
-            };
-            out.push(next);
-        }
-        Ok(out)
+                self.predict(current)
+            }
+        })
     }
 }

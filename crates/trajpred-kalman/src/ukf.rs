@@ -1,6 +1,7 @@
 //! The unscented Kalman filter [`Ukf`] with Merwe's scaled sigma points
 //! ([`MerweSigmaPoints`]) and additive noise, and the unscented RTS smoother.
 
+use crate::alloc::FilterAllocator;
 use crate::error::{KalmanError, Result};
 use crate::filter::{Filter, InputChecks, PredictionWithCross, Smoother, Update, validate_state};
 use crate::linalg::{
@@ -322,12 +323,7 @@ where
     M: Dim,
     Tr: Transition<T, D>,
     Ob: Observation<T, D, M>,
-    DefaultAllocator: Allocator<D>
-        + Allocator<D, D>
-        + Allocator<M>
-        + Allocator<M, M>
-        + Allocator<D, M>
-        + Allocator<M, D>,
+    DefaultAllocator: FilterAllocator<D, M>,
 {
     #[inline(always)]
     fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
@@ -395,12 +391,7 @@ where
     M: Dim,
     Tr: Transition<T, D>,
     Ob: Observation<T, D, M>,
-    DefaultAllocator: Allocator<D>
-        + Allocator<D, D>
-        + Allocator<M>
-        + Allocator<M, M>
-        + Allocator<D, M>
-        + Allocator<M, D>,
+    DefaultAllocator: FilterAllocator<D, M>,
 {
     fn prediction_with_cross_covariance(
         &self,

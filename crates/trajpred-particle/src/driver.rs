@@ -36,6 +36,7 @@ use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
 use rand::Rng;
 use trajpred_core::Gaussian;
+use trajpred_kalman::FilterAllocator;
 use trajpred_kalman::driver::{TimeStepFilter, check_dt};
 use trajpred_kalman::{
     NoisyObservation, NoisyTransition, Observation, ObservationJacobian, Transition,
@@ -71,12 +72,7 @@ where
     M: Dim,
     Tr: TransitionJacobian<T, D> + NoisyTransition<T, D> + Sync,
     Ob: ObservationJacobian<T, D, M> + NoisyObservation<T, D, M> + Sync + Clone,
-    DefaultAllocator: Allocator<D>
-        + Allocator<D, D>
-        + Allocator<M>
-        + Allocator<M, M>
-        + Allocator<D, M>
-        + Allocator<M, D>,
+    DefaultAllocator: FilterAllocator<D, M>,
     OVector<T, D>: Send + Sync,
     OMatrix<T, D, D>: Send + Sync,
     OVector<T, M>: Sync,

@@ -18,6 +18,7 @@ use rand::Rng;
 use rayon::prelude::*;
 use std::marker::PhantomData;
 use trajpred_core::Gaussian;
+use trajpred_kalman::FilterAllocator;
 use trajpred_kalman::{
     AugmentedUkf, Ekf, Filter, KalmanError, MerweSigmaPoints, NoisyObservation, NoisyTransition,
     Observation, ObservationJacobian, TransitionJacobian, Ukf,
@@ -230,12 +231,7 @@ where
     M: Dim,
     Tr: TransitionJacobian<T, D> + NoisyTransition<T, D> + Sync,
     Ob: ObservationJacobian<T, D, M> + NoisyObservation<T, D, M> + Sync,
-    DefaultAllocator: Allocator<D>
-        + Allocator<D, D>
-        + Allocator<M>
-        + Allocator<M, M>
-        + Allocator<D, M>
-        + Allocator<M, D>,
+    DefaultAllocator: FilterAllocator<D, M>,
     OVector<T, D>: Send + Sync,
     OMatrix<T, D, D>: Send + Sync,
     OVector<T, M>: Sync,
@@ -552,12 +548,7 @@ where
     M: Dim,
     Tr: TransitionJacobian<T, D> + NoisyTransition<T, D> + Sync,
     Ob: ObservationJacobian<T, D, M> + NoisyObservation<T, D, M> + Sync,
-    DefaultAllocator: Allocator<D>
-        + Allocator<D, D>
-        + Allocator<M>
-        + Allocator<M, M>
-        + Allocator<D, M>
-        + Allocator<M, D>,
+    DefaultAllocator: FilterAllocator<D, M>,
     OVector<T, D>: Send + Sync,
     OMatrix<T, D, D>: Send + Sync,
     OVector<T, M>: Sync,

@@ -13,6 +13,7 @@ use rand::Rng;
 use rayon::prelude::*;
 use std::marker::PhantomData;
 use trajpred_core::Gaussian;
+use trajpred_kalman::driver::scan;
 use trajpred_kalman::{Observation, Transition};
 
 /// Minimum particles per rayon task: below this the work per particle of the bootstrap
@@ -91,10 +92,7 @@ where
         observations: &[Option<OVector<T, M>>],
         rng: &mut R,
     ) -> Result<Vec<StepSummary<T, D>>> {
-        observations
-            .iter()
-            .map(|z| self.step(z.as_ref(), rng))
-            .collect()
+        scan(observations, |_, z| self.step(z.as_ref(), rng))
     }
 
     /// The k-step forecast as Gaussians (the weighted mean and covariance of each predicted
@@ -206,10 +204,9 @@ where
     OMatrix<T, D, D>: Send + Sync,
 {
     let n = cloud.dim();
-    let mut out: Vec<ParticleCloud<T, D>> = Vec::with_capacity(steps);
     let mut noise: Vec<T> = Vec::new();
-    for _ in 0..steps {
-        let prev = out.last().unwrap_or(cloud);
+    scan(0..steps, |prev: Option<&ParticleCloud<T, D>>, _| {
+        let prev = prev.unwrap_or(cloud);
         noise.clear();
         push_normals(rng, prev.len() * n, &mut noise);
         let particles: Vec<OVector<T, D>> = prev
@@ -219,10 +216,8 @@ where
             .with_min_len(MIN_PARTICLES_PER_TASK)
             .map(|(x, e)| propagate_one(transition, q_factor, x, e))
             .collect::<Result<_>>()?;
-        let next = ParticleCloud::new(particles, prev.log_weights().to_vec())?;
-        out.push(next);
-    }
-    Ok(out)
+        ParticleCloud::new(particles, prev.log_weights().to_vec())
+    })
 }
 
 /// Normalises new log-weights and, if the policy says so, resamples: returns the ancestor

@@ -3,13 +3,15 @@
 //! (filter, then extrapolate `X(k+1) = A X(k)` without correction).
 
 use super::{invalid, positions_forecast, step_interval};
-use nalgebra::{DMatrix, DVector, Dyn};
+use nalgebra::{Const, DefaultAllocator, Dim, Dyn, OMatrix, OVector, U1, U2, U3, U4, U6};
 use serde::{Deserialize, Serialize};
 use trajpred_core::{
     Error, Forecast, Gaussian, Predictor, Result, Trajectory, check_forecast_args,
 };
 use trajpred_kalman::motion::{StateOrder, constant_velocity};
-use trajpred_kalman::{Filter, Kf, LinearObservation, LinearTransition, MultiStep};
+use trajpred_kalman::{
+    Filter, FilterAllocator, Kf, LinearObservation, LinearTransition, MultiStep,
+};
 
 /// Parameters shared by [`KfDynamic`] and [`NaiveKf`]: a constant-velocity state
 /// `[positions, velocities]` with the sampling interval of the history as `dt`.
@@ -142,58 +144,113 @@ impl KfDynamicParams {
     }
 }
 
-type DynKf = Kf<LinearTransition<f64, Dyn>, LinearObservation<f64, Dyn, Dyn>>;
-
 fn kalman_error(method: &str) -> impl Fn(trajpred_kalman::KalmanError) -> Error + '_ {
     move |e| Error::method(method, e)
 }
 
-/// The CV filter for a history, its observations and the initial one-step prediction.
-struct Setup {
-    kf: DynKf,
-    z: Vec<DVector<f64>>,
-    initial: Gaussian<f64, Dyn>,
+/// Which of the two predictors runs.
+#[derive(Clone, Copy)]
+enum Form {
+    /// Eq. 13-15 through the history, then [`KfDynamicParams::multi_step`].
+    Predictor(Continuation),
+    /// Filter through the history, then extrapolate.
+    Naive,
 }
 
-/// Builds the CV filter for `history` and its observation sequence.
-fn build(params: &KfDynamicParams, history: &Trajectory, method: &str) -> Result<Setup> {
+/// Runs `form` on `history` with the constant-velocity filter at state size `N` (`2 d`) and
+/// observation size `M` (`d`, or `2 d` with the velocity observed). Static sizes keep the
+/// filter on the stack; [`forecast`] picks them from the history's dimension.
+fn forecast_sized<N: Dim, M: Dim>(
+    params: &KfDynamicParams,
+    history: &Trajectory,
+    horizon: usize,
+    form: Form,
+    method: &str,
+) -> Result<Forecast>
+where
+    DefaultAllocator: FilterAllocator<N, M>,
+{
+    let err = kalman_error(method);
     let d = history.dim();
-    let n = 2 * d;
+    let (n, m) = (2 * d, if params.observe_velocity { 2 * d } else { d });
+    let (nd, md) = (N::from_usize(n), M::from_usize(m));
     let dt = step_interval(history, history.len());
-    let cv = constant_velocity::<f64, Dyn>(d, dt, 1.0, StateOrder::PositionsFirst)
-        .map_err(kalman_error(method))?;
-    let q = DMatrix::identity(n, n) * params.q;
-    let transition = LinearTransition::new(cv.f().clone(), q).map_err(kalman_error(method))?;
-    let m = if params.observe_velocity { n } else { d };
-    let h = DMatrix::from_fn(m, n, |i, j| if i == j { 1.0 } else { 0.0 });
-    let observation = LinearObservation::new(h, DMatrix::identity(m, m) * params.r)
-        .map_err(kalman_error(method))?;
-    let kf = Kf::new(transition, observation).map_err(kalman_error(method))?;
+    let cv = constant_velocity::<f64, N>(d, dt, 1.0, StateOrder::PositionsFirst).map_err(&err)?;
+    let q = OMatrix::<f64, N, N>::identity_generic(nd, nd) * params.q;
+    let transition = LinearTransition::new(cv.f().clone(), q).map_err(&err)?;
+    let h = OMatrix::<f64, M, N>::identity_generic(md, nd);
+    let r = OMatrix::<f64, M, M>::identity_generic(md, md) * params.r;
+    let kf = Kf::new(transition, LinearObservation::new(h, r).map_err(&err)?).map_err(&err)?;
     let times = history.times();
-    let z: Vec<DVector<f64>> = (0..history.len())
+    let z: Vec<Option<OVector<f64, M>>> = (0..history.len())
         .map(|k| {
             let p = history.point(k);
-            let mut z = DVector::zeros(m);
-            for a in 0..d {
-                z[a] = p[a];
-            }
-            if params.observe_velocity {
-                // finite-difference velocity; the first point borrows the second's
-                let (i, j) = if k == 0 { (0, 1) } else { (k - 1, k) };
-                let (pi, pj) = (history.point(i), history.point(j));
-                for a in 0..d {
-                    z[d + a] = (pj[a] - pi[a]) / (times[j] - times[i]);
-                }
-            }
-            z
+            // the velocity: a finite difference; the first point borrows the second's
+            let (i, j) = if k == 0 { (0, 1) } else { (k - 1, k) };
+            let (pi, pj) = (history.point(i), history.point(j));
+            Some(OVector::<f64, M>::from_fn_generic(
+                md,
+                Const::<1>,
+                |a, _| {
+                    if a < d {
+                        p[a]
+                    } else {
+                        (pj[a - d] - pi[a - d]) / (times[j] - times[i])
+                    }
+                },
+            ))
         })
         .collect();
-    let mut x0 = DVector::zeros(n);
-    for a in 0..d {
-        x0[a] = z[0][a];
+    let mut x0 = OVector::<f64, N>::zeros_generic(nd, Const::<1>);
+    for (a, x) in history.point(0).iter().enumerate() {
+        x0[a] = *x;
     }
-    let initial = Gaussian::new(x0, DMatrix::identity(n, n) * params.p0)?;
-    Ok(Setup { kf, z, initial })
+    let initial = Gaussian::new(
+        x0,
+        OMatrix::<f64, N, N>::identity_generic(nd, nd) * params.p0,
+    )?;
+    let (last, head) = match z.split_last() {
+        Some((Some(last), head)) => (last, head),
+        _ => return Err(Error::Empty { what: "history" }),
+    };
+    let states = match form {
+        Form::Predictor(mode) => {
+            let predictions = kf.predictor_filter(&initial, head).map_err(&err)?;
+            let prediction = predictions.last().unwrap_or(&initial);
+            kf.predictor_forecast(prediction, last, horizon, mode.into())
+        }
+        Form::Naive => {
+            // the first observation updates the initial state directly (no prediction before it)
+            let first = match z.first() {
+                Some(Some(z0)) => kf.update(&initial, z0).map_err(&err)?.posterior,
+                _ => initial,
+            };
+            let steps = kf.filter(&first, &z[1..]).map_err(&err)?;
+            kf.forecast(steps.last().map_or(&first, |s| s.posterior()), horizon)
+        }
+    }
+    .map_err(&err)?;
+    positions_forecast(&states, d)
+}
+
+/// [`forecast_sized`] at the static sizes of a 1-, 2- or 3-D history.
+fn forecast(
+    params: &KfDynamicParams,
+    history: &Trajectory,
+    horizon: usize,
+    form: Form,
+    method: &str,
+) -> Result<Forecast> {
+    let run = match (history.dim(), params.observe_velocity) {
+        (1, false) => forecast_sized::<U2, U1>,
+        (1, true) => forecast_sized::<U2, U2>,
+        (2, false) => forecast_sized::<U4, U2>,
+        (2, true) => forecast_sized::<U4, U4>,
+        (3, false) => forecast_sized::<U6, U3>,
+        (3, true) => forecast_sized::<U6, U6>,
+        _ => forecast_sized::<Dyn, Dyn>,
+    };
+    run(params, history, horizon, form, method)
 }
 
 /// "KF dynamic" (eq. 13-15): the one-step-ahead predictor form of the Kalman filter, run
@@ -238,23 +295,8 @@ impl Predictor for KfDynamic {
     }
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
         check_forecast_args(history, horizon, self.min_history())?;
-        let Setup { kf, z, initial } = build(&self.params, history, self.name())?;
-        let last = z.len() - 1;
-        let mut prediction = initial;
-        for zk in &z[..last] {
-            prediction = kf
-                .predictor_step(&prediction, Some(zk))
-                .map_err(kalman_error(self.name()))?;
-        }
-        let states = kf
-            .predictor_forecast(
-                &prediction,
-                &z[last],
-                horizon,
-                self.params.multi_step.into(),
-            )
-            .map_err(kalman_error(self.name()))?;
-        positions_forecast(&states, history.dim())
+        let form = Form::Predictor(self.params.multi_step);
+        forecast(&self.params, history, horizon, form, self.name())
     }
     fn min_history(&self) -> usize {
         2
@@ -285,20 +327,7 @@ impl Predictor for NaiveKf {
     }
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
         check_forecast_args(history, horizon, self.min_history())?;
-        let Setup { kf, z, initial } = build(&self.params, history, self.name())?;
-        // the first observation updates the initial state directly (no prediction before it)
-        let first = kf
-            .update(&initial, &z[0])
-            .map_err(kalman_error(self.name()))?;
-        let obs: Vec<Option<DVector<f64>>> = z[1..].iter().cloned().map(Some).collect();
-        let steps = kf
-            .filter(&first.posterior, &obs)
-            .map_err(kalman_error(self.name()))?;
-        let last = steps.last().map_or(&first.posterior, |s| s.posterior());
-        let states = kf
-            .forecast(last, horizon)
-            .map_err(kalman_error(self.name()))?;
-        positions_forecast(&states, history.dim())
+        forecast(&self.params, history, horizon, Form::Naive, self.name())
     }
     fn min_history(&self) -> usize {
         2

@@ -16,12 +16,16 @@ pub use kf_time::{KfTime, KfTimeParams};
 pub use particle::{ParticleKind, ParticleParams, ParticlePredictor};
 pub use poly::{PolyFit, PolyFitParams};
 
-use nalgebra::Dyn;
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim};
 use trajpred_core::{Error, Forecast, Gaussian, Result, Trajectory};
 
 /// The forecast of the first `d` state components (the positions, for `[positions,
 /// velocities]` states) of each predicted Gaussian, with their covariances.
-pub(crate) fn positions_forecast(states: &[Gaussian<f64, Dyn>], d: usize) -> Result<Forecast> {
+pub(crate) fn positions_forecast<D: Dim>(states: &[Gaussian<f64, D>], d: usize) -> Result<Forecast>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
     let means: Vec<Vec<f64>> = states
         .iter()
         .map(|g| g.mean.rows(0, d).iter().copied().collect())
