@@ -2,6 +2,7 @@
 
 use super::Resampler;
 use super::common::*;
+use super::residual::{PARTS_MAX, Part, part_count, resample_scaled, residual_total};
 use crate::error::{ParticleError, Result};
 use rand::Rng;
 use rand_distr::{Distribution, Exp1};
@@ -114,7 +115,15 @@ pub(super) fn sorted_multinomial_in_place<R: Rng + ?Sized>(
 }
 
 /// Multinomial resampling: `n` i.i.d. draws from the weights (the indices are returned in
-/// sorted order, drawn as sorted uniforms; the multiset has the multinomial law).
+/// sorted order; the counts have the multinomial law).
+///
+/// Drawn by the residual scheme's remainder sampler with no copies: at a scale
+/// `s < 1 / max w_i` every `w_i s` is its own residual, so the `n` places are drawn
+/// multinomially from `w_i s / sum_k w_k s = w_i / W` (binomial part and block totals, then
+/// rejection or search within a block; see [`Residual`](super::Residual)), in parallel from
+/// `2^17` weights with the same indices on any number of threads. Weights whose largest is
+/// subnormal (where `1 / max w_i` overflows) take the sorted uniforms of exponential
+/// spacings, merged with the cumulative weights, instead.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Multinomial;
 
@@ -125,8 +134,25 @@ impl Resampler for Multinomial {
         rng: &mut R,
         out: &mut [usize],
     ) -> Result<()> {
-        let c = check_weights(weights, out.len())?;
-        sorted_multinomial(rng, |i| weights[i], weights.len(), c.total, c.last, out);
+        let n = out.len();
+        let mut parts = [Part::default(); PARTS_MAX];
+        let parts = &mut parts[..part_count(weights.len())];
+        let total = residual_total(weights, parts, n)?;
+        let most = match parts {
+            [_] => weights
+                .iter()
+                .fold(0.0f64, |a, &w| if w > a { w } else { a }),
+            _ => parts.iter().fold(0.0f64, |a, p| p.max.max(a)),
+        };
+        // below 1 / max w_i (by more than its rounding): every w_i scale is in [0, 1)
+        let scale = (1.0 - f64::EPSILON * 64.0) / most;
+        if scale.is_finite() {
+            resample_scaled(weights, parts, scale, rng, out);
+        } else {
+            // a subnormal largest weight: the sorted uniforms, at the weights' own scale
+            let last = weights.iter().rposition(|&w| w > 0.0).unwrap_or(0);
+            sorted_multinomial(rng, |i| weights[i], weights.len(), total, last, out);
+        }
         Ok(())
     }
     fn name(&self) -> &'static str {

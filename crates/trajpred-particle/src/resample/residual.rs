@@ -139,34 +139,51 @@ impl Resampler for Residual {
         let mut parts = [Part::default(); PARTS_MAX];
         let parts = &mut parts[..part_count(weights.len())];
         let scale = n as f64 / residual_total(weights, parts, n)?;
-        let sums = residual_part_sums(weights, scale, parts);
-        if sums.copies >= n {
-            // no remainder (or, by rounding, copies for more than n places: clamped)
-            write_copies(weights, scale, out);
-            return Ok(());
-        }
-        if sums.residual <= 0.0 {
-            let (k, _, _) = write_copies(weights, scale, out);
-            fill_with_largest(weights, &mut out[k..]);
-            return Ok(());
-        }
-        if u32::try_from(n).is_err() {
-            // beyond the block counts' range: copies, then the sorted-uniform remainder
-            let (k, s, last) = write_copies(weights, scale, out);
-            let residual = |i: usize| split(weights[i], scale).1;
-            sorted_multinomial(rng, residual, weights.len(), s, last, &mut out[k..]);
-            return Ok(());
-        }
-        if let [_] = parts {
-            residual_blocks(weights, 0, scale, sums, rng, out);
-        } else {
-            split_draws(parts, (n - sums.copies) as u64, sums.residual, rng);
-            run_parts(weights, scale, parts, out);
-        }
+        resample_scaled(weights, parts, scale, rng, out);
         Ok(())
     }
     fn name(&self) -> &'static str {
         "residual"
+    }
+}
+
+/// The residual scheme at a given `scale` (the parts cut and the weights checked by
+/// [`residual_total`]): `floor(w_i scale)` copies of each particle, the other
+/// `n - sum floor(w_i scale)` places drawn multinomially from the residuals
+/// `w_i scale - floor(w_i scale)`, sorted. Residual resampling takes `scale = n / W`;
+/// multinomial resampling takes a scale below `1 / max w_i`, so that there are no copies and
+/// the residuals are proportional to the weights.
+pub(super) fn resample_scaled<R: Rng + ?Sized>(
+    weights: &[f64],
+    parts: &mut [Part],
+    scale: f64,
+    rng: &mut R,
+    out: &mut [usize],
+) {
+    let n = out.len();
+    let sums = residual_part_sums(weights, scale, parts);
+    if sums.copies >= n {
+        // no remainder (or, by rounding, copies for more than n places: clamped)
+        write_copies(weights, scale, out);
+        return;
+    }
+    if sums.residual <= 0.0 {
+        let (k, _, _) = write_copies(weights, scale, out);
+        fill_with_largest(weights, &mut out[k..]);
+        return;
+    }
+    if u32::try_from(n).is_err() {
+        // beyond the block counts' range: copies, then the sorted-uniform remainder
+        let (k, s, last) = write_copies(weights, scale, out);
+        let residual = |i: usize| split(weights[i], scale).1;
+        sorted_multinomial(rng, residual, weights.len(), s, last, &mut out[k..]);
+        return;
+    }
+    if let [_] = parts {
+        residual_blocks(weights, 0, scale, sums, rng, out);
+    } else {
+        split_draws(parts, (n - sums.copies) as u64, sums.residual, rng);
+        run_parts(weights, scale, parts, out);
     }
 }
 
@@ -273,6 +290,8 @@ pub(super) struct Part {
     start: usize,
     end: usize,
     weight_sum: f64,
+    /// The largest weight of the part (filled in with `weight_sum`).
+    pub(super) max: f64,
     sums: ResidualSums,
     draws: u64,
     seed: [u8; 32],
@@ -321,19 +340,23 @@ pub(super) fn residual_total(weights: &[f64], parts: &mut [Part], n: usize) -> R
         let mut s = [0.0f64; 4];
         // the least weight of each lane (a NaN makes the sum NaN instead)
         let mut least = [0.0f64; 4];
+        let mut most = [0.0f64; 4];
         let chunks = weights[p.start..p.end].chunks_exact(4);
         let rest = chunks.remainder();
         for q in chunks {
             for l in 0..4 {
                 s[l] += q[l];
                 least[l] = if q[l] < least[l] { q[l] } else { least[l] };
+                most[l] = if q[l] > most[l] { q[l] } else { most[l] };
             }
         }
         for &v in rest {
             s[0] += v;
             least[0] = if v < least[0] { v } else { least[0] };
+            most[0] = if v > most[0] { v } else { most[0] };
         }
         let negative = least.iter().any(|&v| v < 0.0);
+        p.max = most.iter().fold(0.0, |a, &b| if b > a { b } else { a });
         p.weight_sum = if negative {
             f64::NAN
         } else {
