@@ -24,9 +24,11 @@
 //!
 //! The random variants ([`Resampler::resample_into`]) run in `O(n + N)` without allocating
 //! (their scratch is a few fixed-size arrays on the stack) and return sorted indices. The
-//! multinomial scheme draws *sorted* uniforms as normalised cumulative sums of exponential
-//! variates (the order statistics of uniforms), so the selection is one merge pass instead
-//! of a binary search per draw. The residual scheme draws its remainder per block of
+//! stratified scheme runs as counts per particle (`floor(x_i) + [u < frac(x_i)]` with
+//! `x_i = C_i n / W` and `u` the uniform of stratum `floor(x_i)`, computed from a key by
+//! SplitMix64, so any thread can compute it), split in two halves like the systematic one.
+//! The multinomial scheme is the residual scheme's remainder sampler with no copies (at a
+//! scale below `1 / max w_i` each `w_i` is its own residual). The residual scheme draws its remainder per block of
 //! particles: the block's number of draws is binomial given the draws left (the conditional
 //! law of a multinomial's block totals), and each draw is a slot of the block accepted with
 //! probability its residual (rejection, two tries per 64-bit draw, about one try per

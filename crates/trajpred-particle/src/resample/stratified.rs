@@ -53,11 +53,12 @@ pub fn stratified_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) 
 /// Stratified resampling: positions `(j + u_j) / n` with an independent uniform per
 /// stratum.
 ///
-/// The uniforms are counter-based: `u_j` is the SplitMix64 output for the counter `j` under
+/// The uniforms are counter-based: `u_j` is the SplitMix64 output for the counter `j + 1` under
 /// a key, one 64-bit draw from the caller's generator (its top 53 bits as `u_j in [0, 1)`).
 /// So each `u_j` can be computed where it is needed, by any thread, and a seed gives the
 /// same indices on any number of threads. The pass is counts per particle, like
-/// [`Systematic`](super::Systematic): see [`stratified_counts`].
+/// [`Systematic`](super::Systematic): particle `i` gets `floor(x_i) + [u < frac(x_i)]` slots in
+/// all, `x_i = C_i n / W`, `u` the uniform of the stratum `floor(x_i)`.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Stratified;
 
