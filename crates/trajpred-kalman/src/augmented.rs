@@ -101,10 +101,12 @@ where
 
 impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
     /// An augmented UKF; the sigma-point weights are for the augmented dimension `2n + m`.
-    pub fn new<D, M>(transition: Tr, observation: Ob, points: MerweSigmaPoints<T>) -> Result<Self>
+    pub fn new<D: Dim, M: Dim>(
+        transition: Tr,
+        observation: Ob,
+        points: MerweSigmaPoints<T>,
+    ) -> Result<Self>
     where
-        D: Dim,
-        M: Dim,
         Tr: NoisyTransition<T, D>,
         Ob: NoisyObservation<T, D, M>,
         DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M>,
@@ -125,10 +127,8 @@ impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
         &self.points
     }
 
-    fn moments<D, M>(&self, state: &Gaussian<T, D>) -> Result<AugmentedMoments<T, D, M>>
+    fn moments<D: Dim, M: Dim>(&self, state: &Gaussian<T, D>) -> Result<AugmentedMoments<T, D, M>>
     where
-        D: Dim,
-        M: Dim,
         Tr: NoisyTransition<T, D>,
         Ob: NoisyObservation<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,
@@ -221,10 +221,8 @@ impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
 
     /// The prior `N(y_bar, P_bar)` of one augmented step (the same as [`AugmentedUkf::step`]'s
     /// prior).
-    pub fn predict<D, M>(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>>
+    pub fn predict<D: Dim, M: Dim>(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>>
     where
-        D: Dim,
-        M: Dim,
         Tr: NoisyTransition<T, D>,
         Ob: NoisyObservation<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,
@@ -234,14 +232,12 @@ impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
 
     /// One augmented step: prior from the propagated points, then (when `z` is observed) the
     /// update from the same points.
-    pub fn step<D, M>(
+    pub fn step<D: Dim, M: Dim>(
         &self,
         state: &Gaussian<T, D>,
         z: Option<&OVector<T, M>>,
     ) -> Result<Step<T, D, M>>
     where
-        D: Dim,
-        M: Dim,
         Tr: NoisyTransition<T, D>,
         Ob: NoisyObservation<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,
@@ -282,14 +278,12 @@ impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
     }
 
     /// [`AugmentedUkf::step`] over a sequence (missing observations are `None`).
-    pub fn filter<D, M>(
+    pub fn filter<D: Dim, M: Dim>(
         &self,
         initial: &Gaussian<T, D>,
         observations: &[Option<OVector<T, M>>],
     ) -> Result<Vec<Step<T, D, M>>>
     where
-        D: Dim,
-        M: Dim,
         Tr: NoisyTransition<T, D>,
         Ob: NoisyObservation<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,

@@ -184,11 +184,8 @@ where
     }
 }
 
-impl<T, D, M, F, Make> TimeStepFilter<T, D, M> for Timed<T, D, F, Make>
+impl<T: RealField + Copy, D: Dim, M: Dim, F, Make> TimeStepFilter<T, D, M> for Timed<T, D, F, Make>
 where
-    T: RealField + Copy,
-    D: Dim,
-    M: Dim,
     F: Filter<T, D, M>,
     Make: Fn(T) -> Result<F>,
     DefaultAllocator: FilterAllocator<D, M>,

@@ -391,34 +391,6 @@ where
     })
 }
 
-/// The prediction of the linear KF, `x' = F x`, `P' = F P F^T + Q`, with the input checks
-/// `checks`, through the model's [`LinearTransitionModel::propagate_mean`] and
-/// [`LinearTransitionModel::propagate_covariance`]. With `factorise` and static sizes the
-/// definiteness check of `P` is an `L D L^T` factorisation: for a dense `F` the one from
-/// which `F P F^T` is then formed ([`congruence_ldl`]), for a structured `F` a factorisation
-/// of its own before the cheap structured product; either way a `P` that is only
-/// semi-definite (or fails any check) takes the check `checks` of [`validate_state`]. The
-/// caller passes the same `factorise` for `predict` and `predict_own_output`, so a batch
-/// and the same steps one by one give identical results.
-#[inline(always)]
-pub(crate) fn linear_predict<T, D, Tr>(
-    tr: &Tr,
-    state: &Gaussian<T, D>,
-    n: usize,
-    factorise: bool,
-    checks: InputChecks,
-) -> Result<Gaussian<T, D>>
-where
-    T: RealField + Copy,
-    D: Dim,
-    Tr: LinearTransitionModel<T, D> + ?Sized,
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    let prior = linear_predict_unchecked_output(tr, state, n, factorise, checks)?;
-    check_prediction(&prior)?;
-    Ok(prior)
-}
-
 /// A prediction's mean and covariance are finite, or [`KalmanError::NonFinite`] naming the
 /// first that is not (one branch; the element is located only on failure).
 #[inline(always)]
@@ -435,8 +407,18 @@ where
     Ok(())
 }
 
-/// [`linear_predict`] without the finiteness check of its result (its input checks are
-/// all made), for a caller that proves the result finite otherwise.
+/// The prediction of the linear KF, `x' = F x`, `P' = F P F^T + Q`, with the input checks
+/// `checks`, through the model's [`LinearTransitionModel::propagate_mean`] and
+/// [`LinearTransitionModel::propagate_covariance`]. With `factorise` and static sizes the
+/// definiteness check of `P` is an `L D L^T` factorisation: for a dense `F` the one from
+/// which `F P F^T` is then formed ([`congruence_ldl`]), for a structured `F` a factorisation
+/// of its own before the cheap structured product; either way a `P` that is only
+/// semi-definite (or fails any check) takes the check `checks` of [`validate_state`]. The
+/// caller passes the same `factorise` for `predict` and `predict_own_output`, so a batch
+/// and the same steps one by one give identical results.
+///
+/// The result's finiteness is not checked: the caller calls [`check_prediction`] or proves
+/// it finite otherwise.
 #[inline(always)]
 pub(crate) fn linear_predict_unchecked_output<T, D, Tr>(
     tr: &Tr,

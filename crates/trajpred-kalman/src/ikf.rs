@@ -106,11 +106,8 @@ pub struct Ikf<Tr, Ob> {
 
 impl<Tr, Ob> Ikf<Tr, Ob> {
     /// An IKF from a linear transition (`F`, `Q`) and observation (`H`, `R`).
-    pub fn new<T, D, M>(transition: Tr, observation: Ob) -> Result<Self>
+    pub fn new<T: RealField + Copy, D: Dim, M: Dim>(transition: Tr, observation: Ob) -> Result<Self>
     where
-        T: RealField + Copy,
-        D: Dim,
-        M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,
@@ -137,11 +134,11 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
     }
 
     /// `P(k|k-1) = F P F^T + Q`.
-    pub fn propagate_covariance<T, D, M>(&self, p: &OMatrix<T, D, D>) -> Result<OMatrix<T, D, D>>
+    pub fn propagate_covariance<T: RealField + Copy, D: Dim, M: Dim>(
+        &self,
+        p: &OMatrix<T, D, D>,
+    ) -> Result<OMatrix<T, D, D>>
     where
-        T: RealField + Copy,
-        D: Dim,
-        M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,
@@ -158,11 +155,11 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
     }
 
     /// The prediction `N(F x, F P F^T + Q)`.
-    pub fn predict<T, D, M>(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>>
+    pub fn predict<T: RealField + Copy, D: Dim, M: Dim>(
+        &self,
+        state: &Gaussian<T, D>,
+    ) -> Result<Gaussian<T, D>>
     where
-        T: RealField + Copy,
-        D: Dim,
-        M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,
@@ -175,15 +172,12 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
     }
 
     /// `V = z - H X(k|k-1)` and `S = H P(k|k-1) H^T + R` of an observation.
-    pub fn innovation<T, D, M>(
+    pub fn innovation<T: RealField + Copy, D: Dim, M: Dim>(
         &self,
         prior: &Gaussian<T, D>,
         z: &OVector<T, M>,
     ) -> Result<Innovation<T, M>>
     where
-        T: RealField + Copy,
-        D: Dim,
-        M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,
@@ -201,15 +195,12 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
 
     /// Eq. 12-13: the corrected one-step-ahead prediction
     /// `X(k|k) = X(k|k-1) + P(k|k-1) H^T S(k-1)^-1 V(k-1)` and its covariance.
-    pub fn correct<T, D, M>(
+    pub fn correct<T: RealField + Copy, D: Dim, M: Dim>(
         &self,
         prior: &Gaussian<T, D>,
         previous: &Innovation<T, M>,
     ) -> Result<Gaussian<T, D>>
     where
-        T: RealField + Copy,
-        D: Dim,
-        M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,
@@ -252,16 +243,13 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
 
     /// One step: predict from `state`, correct with the previous innovation (if any), and
     /// form this step's innovation from `z` (if observed).
-    pub fn step<T, D, M>(
+    pub fn step<T: RealField + Copy, D: Dim, M: Dim>(
         &self,
         state: &Gaussian<T, D>,
         previous: Option<&Innovation<T, M>>,
         z: Option<&OVector<T, M>>,
     ) -> Result<IkfStep<T, D, M>>
     where
-        T: RealField + Copy,
-        D: Dim,
-        M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,
@@ -285,15 +273,12 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
     /// Runs [`Ikf::step`] over a sequence: step `k`'s `corrected` is the one-step-ahead
     /// prediction of time `k` using observations up to `k-1` only. A missing observation
     /// leaves the most recent innovation in use.
-    pub fn filter<T, D, M>(
+    pub fn filter<T: RealField + Copy, D: Dim, M: Dim>(
         &self,
         initial: &Gaussian<T, D>,
         observations: &[Option<OVector<T, M>>],
     ) -> Result<Vec<IkfStep<T, D, M>>>
     where
-        T: RealField + Copy,
-        D: Dim,
-        M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,

@@ -6,8 +6,8 @@ use crate::alloc::FilterAllocator;
 use crate::error::Result;
 use crate::filter::{
     CovarianceUpdate, Filter, InputChecks, PredictionAndUpdate, PredictionWithCross, Smoother,
-    Update, check_prediction, finish_update, linear_predict, linear_predict_unchecked_output,
-    linearized_predict, linearized_update, selection_products, validate_state,
+    Update, check_prediction, finish_update, linear_predict_unchecked_output, linearized_predict,
+    linearized_update, selection_products, validate_state,
 };
 use crate::linalg::{check_dim, check_finite, exactly_symmetric, is_static, mul_vec};
 use crate::model::{
@@ -17,6 +17,44 @@ use crate::model::{
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OVector, RealField};
 use trajpred_core::Gaussian;
+
+/// The settings and accessors that [`Kf`] and [`Ekf`] share (both hold a transition, an
+/// observation, a covariance update form and input checks).
+macro_rules! settings {
+    ($filter:ident) => {
+        impl<Tr, Ob> $filter<Tr, Ob> {
+            /// Selects the covariance update form.
+            pub fn with_covariance_update(mut self, form: CovarianceUpdate) -> Self {
+                self.covariance_update = form;
+                self
+            }
+
+            /// Selects how much of the input state is verified ([`InputChecks::Full`] by
+            /// default).
+            pub fn with_input_checks(mut self, checks: InputChecks) -> Self {
+                self.checks = checks;
+                self
+            }
+
+            /// The covariance update form in use.
+            pub fn covariance_update(&self) -> CovarianceUpdate {
+                self.covariance_update
+            }
+
+            /// The transition model.
+            pub fn transition(&self) -> &Tr {
+                &self.transition
+            }
+
+            /// The observation model.
+            pub fn observation(&self) -> &Ob {
+                &self.observation
+            }
+        }
+    };
+}
+settings!(Kf);
+settings!(Ekf);
 
 /// The linear Kalman filter.
 ///
@@ -63,11 +101,8 @@ impl<Tr, Ob> Kf<Tr, Ob> {
     /// A KF from a linear transition (F, Q) and a linear observation (H, R), with the
     /// Joseph-form covariance update. Checks `Q` (positive semi-definite) and `R` (positive
     /// definite) once here.
-    pub fn new<T, D, M>(transition: Tr, observation: Ob) -> Result<Self>
+    pub fn new<T: RealField + Copy, D: Dim, M: Dim>(transition: Tr, observation: Ob) -> Result<Self>
     where
-        T: RealField + Copy,
-        D: Dim,
-        M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
         DefaultAllocator:
@@ -95,62 +130,39 @@ impl<Tr, Ob> Kf<Tr, Ob> {
         })
     }
 
-    /// Selects the covariance update form.
-    pub fn with_covariance_update(mut self, form: CovarianceUpdate) -> Self {
-        self.covariance_update = form;
-        self
-    }
-
-    /// Selects how much of the input state is verified ([`InputChecks::Full`] by default).
-    pub fn with_input_checks(mut self, checks: InputChecks) -> Self {
-        self.checks = checks;
-        self
-    }
-
-    /// The covariance update form in use.
-    pub fn covariance_update(&self) -> CovarianceUpdate {
-        self.covariance_update
-    }
-
-    /// The transition model.
-    pub fn transition(&self) -> &Tr {
-        &self.transition
-    }
-
-    /// The observation model.
-    pub fn observation(&self) -> &Ob {
-        &self.observation
+    /// The prediction with the input checks `checks`, its finiteness not yet checked
+    /// ([`linear_predict_unchecked_output`]).
+    #[inline(always)]
+    fn prior<T, D>(&self, state: &Gaussian<T, D>, checks: InputChecks) -> Result<Gaussian<T, D>>
+    where
+        T: RealField + Copy,
+        D: Dim,
+        Tr: LinearTransitionModel<T, D>,
+        DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    {
+        let n = self.transition.state_dim();
+        let factorise = self.checks == InputChecks::Full;
+        linear_predict_unchecked_output(&self.transition, state, n, factorise, checks)
     }
 }
 
-impl<T, D, M, Tr, Ob> Filter<T, D, M> for Kf<Tr, Ob>
+impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> Filter<T, D, M> for Kf<Tr, Ob>
 where
-    T: RealField + Copy,
-    D: Dim,
-    M: Dim,
     Tr: LinearTransitionModel<T, D>,
     Ob: LinearObservationModel<T, D, M>,
     DefaultAllocator: FilterAllocator<D, M>,
 {
     #[inline(always)]
     fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
-        linear_predict(
-            &self.transition,
-            state,
-            self.transition.state_dim(),
-            self.checks == InputChecks::Full,
-            self.checks,
-        )
+        let prior = self.prior(state, self.checks)?;
+        check_prediction(&prior)?;
+        Ok(prior)
     }
 
     fn predict_own_output(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
-        linear_predict(
-            &self.transition,
-            state,
-            self.transition.state_dim(),
-            self.checks == InputChecks::Full,
-            InputChecks::Cheap,
-        )
+        let prior = self.prior(state, InputChecks::Cheap)?;
+        check_prediction(&prior)?;
+        Ok(prior)
     }
 
     fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>> {
@@ -178,13 +190,7 @@ where
         } else {
             self.checks
         };
-        let prior = linear_predict_unchecked_output(
-            &self.transition,
-            state,
-            self.transition.state_dim(),
-            self.checks == InputChecks::Full,
-            checks,
-        )?;
+        let prior = self.prior(state, checks)?;
         match self.update_predicted(&prior, z) {
             Ok(update) => {
                 if !self.transition.mirrors_covariance() && !exactly_symmetric(&prior.covariance) {
@@ -243,11 +249,8 @@ where
     }
 }
 
-impl<T, D, M, Tr, Ob> Smoother<T, D, M> for Kf<Tr, Ob>
+impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> Smoother<T, D, M> for Kf<Tr, Ob>
 where
-    T: RealField + Copy,
-    D: Dim,
-    M: Dim,
     Tr: LinearTransitionModel<T, D>,
     Ob: LinearObservationModel<T, D, M>,
     DefaultAllocator: FilterAllocator<D, M>,
@@ -278,11 +281,8 @@ pub struct Ekf<Tr, Ob> {
 
 impl<Tr, Ob> Ekf<Tr, Ob> {
     /// An EKF from models with Jacobians; checks `Q` and `R` once here.
-    pub fn new<T, D, M>(transition: Tr, observation: Ob) -> Result<Self>
+    pub fn new<T: RealField + Copy, D: Dim, M: Dim>(transition: Tr, observation: Ob) -> Result<Self>
     where
-        T: RealField + Copy,
-        D: Dim,
-        M: Dim,
         Tr: TransitionJacobian<T, D>,
         Ob: ObservationJacobian<T, D, M>,
         DefaultAllocator:
@@ -296,35 +296,10 @@ impl<Tr, Ob> Ekf<Tr, Ob> {
             checks: InputChecks::Full,
         })
     }
-
-    /// Selects the covariance update form.
-    pub fn with_covariance_update(mut self, form: CovarianceUpdate) -> Self {
-        self.covariance_update = form;
-        self
-    }
-
-    /// Selects how much of the input state is verified ([`InputChecks::Full`] by default).
-    pub fn with_input_checks(mut self, checks: InputChecks) -> Self {
-        self.checks = checks;
-        self
-    }
-
-    /// The transition model.
-    pub fn transition(&self) -> &Tr {
-        &self.transition
-    }
-
-    /// The observation model.
-    pub fn observation(&self) -> &Ob {
-        &self.observation
-    }
 }
 
-impl<T, D, M, Tr, Ob> Filter<T, D, M> for Ekf<Tr, Ob>
+impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> Filter<T, D, M> for Ekf<Tr, Ob>
 where
-    T: RealField + Copy,
-    D: Dim,
-    M: Dim,
     Tr: TransitionJacobian<T, D>,
     Ob: ObservationJacobian<T, D, M>,
     DefaultAllocator: FilterAllocator<D, M>,
@@ -374,11 +349,8 @@ impl<Tr, Ob> Ekf<Tr, Ob> {
     }
 }
 
-impl<T, D, M, Tr, Ob> Smoother<T, D, M> for Ekf<Tr, Ob>
+impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> Smoother<T, D, M> for Ekf<Tr, Ob>
 where
-    T: RealField + Copy,
-    D: Dim,
-    M: Dim,
     Tr: TransitionJacobian<T, D>,
     Ob: ObservationJacobian<T, D, M>,
     DefaultAllocator: FilterAllocator<D, M>,

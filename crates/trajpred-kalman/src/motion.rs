@@ -122,10 +122,12 @@ fn state_dim_type<D: Dim>(n: usize) -> Result<D> {
 /// The kinematic transition of `layout` for the time step `dt`, with the discrete
 /// white-noise process noise of variance `var` per axis (filterpy's
 /// `Q_discrete_white_noise`).
-pub fn kinematic<T, D>(layout: KinematicLayout, dt: f64, var: f64) -> Result<LinearTransition<T, D>>
+pub fn kinematic<T: RealField + Copy, D: Dim>(
+    layout: KinematicLayout,
+    dt: f64,
+    var: f64,
+) -> Result<LinearTransition<T, D>>
 where
-    T: RealField + Copy,
-    D: Dim,
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     check_positive("dt", dt, false)?;
@@ -180,14 +182,12 @@ fn continuous_noise_block(derivatives: usize, dt: f64, q: f64) -> [[f64; 3]; 3] 
 /// assert_eq!(cv.process_noise()[(1, 1)], 6.0);
 /// # Ok::<(), trajpred_kalman::KalmanError>(())
 /// ```
-pub fn kinematic_continuous<T, D>(
+pub fn kinematic_continuous<T: RealField + Copy, D: Dim>(
     layout: KinematicLayout,
     dt: f64,
     spectral_density: f64,
 ) -> Result<LinearTransition<T, D>>
 where
-    T: RealField + Copy,
-    D: Dim,
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     check_positive("dt", dt, false)?;
@@ -227,15 +227,13 @@ where
 /// assert!((damped.process_noise() - cv.process_noise()).abs().max() < 1e-8);
 /// # Ok::<(), trajpred_kalman::KalmanError>(())
 /// ```
-pub fn damped_velocity<T, D>(
+pub fn damped_velocity<T: RealField + Copy, D: Dim>(
     layout: KinematicLayout,
     dt: f64,
     spectral_density: f64,
     time_constant: f64,
 ) -> Result<LinearTransition<T, D>>
 where
-    T: RealField + Copy,
-    D: Dim,
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     check_positive("dt", dt, false)?;
@@ -306,15 +304,13 @@ where
 /// assert_eq!(cv.transition(&Vector4::new(0.0, 0.0, 2.0, -2.0))?, Vector4::new(1.0, -1.0, 2.0, -2.0));
 /// # Ok::<(), trajpred_kalman::KalmanError>(())
 /// ```
-pub fn constant_velocity<T, D>(
+pub fn constant_velocity<T: RealField + Copy, D: Dim>(
     axes: usize,
     dt: f64,
     var: f64,
     order: StateOrder,
 ) -> Result<LinearTransition<T, D>>
 where
-    T: RealField + Copy,
-    D: Dim,
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     kinematic(KinematicLayout::new(axes, 2, order)?, dt, var)
@@ -322,15 +318,13 @@ where
 
 /// Constant acceleration in `axes` axes (state `3 * axes`) for the time step `dt` and the
 /// white-noise jerk variance `var`.
-pub fn constant_acceleration<T, D>(
+pub fn constant_acceleration<T: RealField + Copy, D: Dim>(
     axes: usize,
     dt: f64,
     var: f64,
     order: StateOrder,
 ) -> Result<LinearTransition<T, D>>
 where
-    T: RealField + Copy,
-    D: Dim,
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     kinematic(KinematicLayout::new(axes, 3, order)?, dt, var)

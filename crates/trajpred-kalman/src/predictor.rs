@@ -50,15 +50,12 @@ impl<Tr, Ob> Kf<Tr, Ob> {
     /// Eq. 13-15: from the one-step-ahead prediction `N(X(k|k-1), P(k|k-1))` and the
     /// observation `Z(k)` (or `None` when missing: then `K = 0`), the next one
     /// `N(X(k+1|k), P(k+1|k))`.
-    pub fn predictor_step<T, D, M>(
+    pub fn predictor_step<T: RealField + Copy, D: Dim, M: Dim>(
         &self,
         prediction: &Gaussian<T, D>,
         z: Option<&OVector<T, M>>,
     ) -> Result<Gaussian<T, D>>
     where
-        T: RealField + Copy,
-        D: Dim,
-        M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,
@@ -97,15 +94,12 @@ impl<Tr, Ob> Kf<Tr, Ob> {
 
     /// Runs eq. 13-15 over a sequence from `N(X(1|0), P(1|0))`: element `k` is
     /// `N(X(k+2|k+1), ...)`, the prediction of the time after observation `k`.
-    pub fn predictor_filter<T, D, M>(
+    pub fn predictor_filter<T: RealField + Copy, D: Dim, M: Dim>(
         &self,
         first_prediction: &Gaussian<T, D>,
         observations: &[Option<OVector<T, M>>],
     ) -> Result<Vec<Gaussian<T, D>>>
     where
-        T: RealField + Copy,
-        D: Dim,
-        M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,
@@ -118,7 +112,7 @@ impl<Tr, Ob> Kf<Tr, Ob> {
     /// The `steps`-step forecast `N(X(k+j|k), P(k+j|k))`, `j = 1..=steps`, from the
     /// prediction `N(X(k|k-1), P(k|k-1))` and the latest observation `Z(k)`: the first step
     /// is eq. 13-15; later steps follow `mode`.
-    pub fn predictor_forecast<T, D, M>(
+    pub fn predictor_forecast<T: RealField + Copy, D: Dim, M: Dim>(
         &self,
         prediction: &Gaussian<T, D>,
         last_observation: &OVector<T, M>,
@@ -126,9 +120,6 @@ impl<Tr, Ob> Kf<Tr, Ob> {
         mode: MultiStep,
     ) -> Result<Vec<Gaussian<T, D>>>
     where
-        T: RealField + Copy,
-        D: Dim,
-        M: Dim,
         Tr: LinearTransitionModel<T, D>,
         Ob: LinearObservationModel<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,

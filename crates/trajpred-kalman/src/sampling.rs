@@ -15,10 +15,11 @@ use rand_distr::StandardNormal;
 /// A square root `L` of a covariance (`L L^T = C`) for sampling: the Cholesky factor, or for a
 /// positive semi-definite but singular `C` (the discrete white-noise `Q`), the factor of
 /// `C + 64 n eps max|C| I`; for `C = 0` the zero matrix.
-pub fn covariance_sqrt<T, D>(c: &OMatrix<T, D, D>, what: &'static str) -> Result<OMatrix<T, D, D>>
+pub fn covariance_sqrt<T: RealField + Copy, D: Dim>(
+    c: &OMatrix<T, D, D>,
+    what: &'static str,
+) -> Result<OMatrix<T, D, D>>
 where
-    T: RealField + Copy,
-    D: Dim,
     DefaultAllocator: Allocator<D, D> + Allocator<D>,
 {
     crate::linalg::check_psd(c, what)?;

@@ -277,10 +277,12 @@ impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
     /// A UKF from a transition (`f`, `Q`), an observation (`h`, `R`) and sigma-point
     /// parameters. Errors: [`KalmanError::DegenerateSigmaPoints`], and the model checks of
     /// `Q` and `R`.
-    pub fn new<D, M>(transition: Tr, observation: Ob, points: MerweSigmaPoints<T>) -> Result<Self>
+    pub fn new<D: Dim, M: Dim>(
+        transition: Tr,
+        observation: Ob,
+        points: MerweSigmaPoints<T>,
+    ) -> Result<Self>
     where
-        D: Dim,
-        M: Dim,
         Tr: Transition<T, D>,
         Ob: Observation<T, D, M>,
         DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M>,
@@ -316,11 +318,8 @@ impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
     }
 }
 
-impl<T, D, M, Tr, Ob> Filter<T, D, M> for Ukf<T, Tr, Ob>
+impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> Filter<T, D, M> for Ukf<T, Tr, Ob>
 where
-    T: RealField + Copy,
-    D: Dim,
-    M: Dim,
     Tr: Transition<T, D>,
     Ob: Observation<T, D, M>,
     DefaultAllocator: FilterAllocator<D, M>,
@@ -384,11 +383,8 @@ where
     }
 }
 
-impl<T, D, M, Tr, Ob> Smoother<T, D, M> for Ukf<T, Tr, Ob>
+impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> Smoother<T, D, M> for Ukf<T, Tr, Ob>
 where
-    T: RealField + Copy,
-    D: Dim,
-    M: Dim,
     Tr: Transition<T, D>,
     Ob: Observation<T, D, M>,
     DefaultAllocator: FilterAllocator<D, M>,

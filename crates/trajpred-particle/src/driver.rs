@@ -49,11 +49,9 @@ pub trait WithTransition<Tr>: Sized {
     fn with_transition(&self, transition: Tr) -> Result<Self>;
 }
 
-impl<T, D, M, Tr, Ob> WithTransition<Tr> for ParticleFilter<T, D, M, Tr, Ob>
+impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> WithTransition<Tr>
+    for ParticleFilter<T, D, M, Tr, Ob>
 where
-    T: RealField + Copy,
-    D: Dim,
-    M: Dim,
     Tr: Transition<T, D> + Sync,
     Ob: Observation<T, D, M> + Sync + Clone,
     DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M>,
@@ -65,11 +63,8 @@ where
     }
 }
 
-impl<T, D, M, Tr, Ob> WithTransition<Tr> for Mkpf<T, D, M, Tr, Ob>
+impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> WithTransition<Tr> for Mkpf<T, D, M, Tr, Ob>
 where
-    T: RealField + Copy,
-    D: Dim,
-    M: Dim,
     Tr: TransitionJacobian<T, D> + NoisyTransition<T, D> + Sync,
     Ob: ObservationJacobian<T, D, M> + NoisyObservation<T, D, M> + Sync + Clone,
     DefaultAllocator: FilterAllocator<D, M>,
@@ -112,11 +107,9 @@ impl<T, F, Make, R> TimedParticles<T, F, Make, R> {
     }
 }
 
-impl<T, D, M, F, Tr, Make, R> TimeStepFilter<T, D, M> for TimedParticles<T, F, Make, R>
+impl<T: RealField + Copy, D: Dim, M: Dim, F, Tr, Make, R> TimeStepFilter<T, D, M>
+    for TimedParticles<T, F, Make, R>
 where
-    T: RealField + Copy,
-    D: Dim,
-    M: Dim,
     F: ParticleFiltering<T, D, M> + WithTransition<Tr>,
     Tr: Transition<T, D>,
     Make: Fn(T) -> trajpred_kalman::Result<Tr>,

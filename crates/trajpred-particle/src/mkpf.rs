@@ -4,12 +4,10 @@
 
 use crate::cloud::ParticleCloud;
 use crate::error::{ParticleError, Result};
-use crate::gauss::{
-    Density, first_non_finite, log_det_half, psd_factor, push_normals, shifted, to_f64,
-};
+use crate::gauss::{Density, first_non_finite, log_det_half, psd_factor, shifted, to_f64};
 use crate::pf::{
-    MIN_PARTICLES_PER_TASK, ParticleFiltering, PfConfig, StepSummary, check_observation,
-    log_likelihood, predict_clouds, propagate_one, weigh_and_select,
+    MIN_PARTICLES_PER_TASK, ParticleFiltering, PfConfig, StepSummary, log_likelihood,
+    predict_clouds, propagate_one, step_noise, weigh_and_select,
 };
 use crate::weights::normalize_log_weights;
 use nalgebra::allocator::Allocator;
@@ -95,11 +93,8 @@ where
     jacobian: OMatrix<T, M, D>,
 }
 
-impl<T, D, M, Ob> Observation<T, D, M> for Linearized<'_, T, D, M, Ob>
+impl<T: RealField + Copy, D: Dim, M: Dim, Ob> Observation<T, D, M> for Linearized<'_, T, D, M, Ob>
 where
-    T: RealField + Copy,
-    D: Dim,
-    M: Dim,
     Ob: Observation<T, D, M>,
     DefaultAllocator:
         Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M> + Allocator<M, D>,
@@ -121,11 +116,9 @@ where
     }
 }
 
-impl<T, D, M, Ob> ObservationJacobian<T, D, M> for Linearized<'_, T, D, M, Ob>
+impl<T: RealField + Copy, D: Dim, M: Dim, Ob> ObservationJacobian<T, D, M>
+    for Linearized<'_, T, D, M, Ob>
 where
-    T: RealField + Copy,
-    D: Dim,
-    M: Dim,
     Ob: Observation<T, D, M>,
     DefaultAllocator:
         Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M> + Allocator<M, D>,
@@ -224,11 +217,8 @@ where
     fallback: bool,
 }
 
-impl<T, D, M, Tr, Ob> Mkpf<T, D, M, Tr, Ob>
+impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> Mkpf<T, D, M, Tr, Ob>
 where
-    T: RealField + Copy,
-    D: Dim,
-    M: Dim,
     Tr: TransitionJacobian<T, D> + NoisyTransition<T, D> + Sync,
     Ob: ObservationJacobian<T, D, M> + NoisyObservation<T, D, M> + Sync,
     DefaultAllocator: FilterAllocator<D, M>,
@@ -541,11 +531,9 @@ where
     }
 }
 
-impl<T, D, M, Tr, Ob> ParticleFiltering<T, D, M> for Mkpf<T, D, M, Tr, Ob>
+impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> ParticleFiltering<T, D, M>
+    for Mkpf<T, D, M, Tr, Ob>
 where
-    T: RealField + Copy,
-    D: Dim,
-    M: Dim,
     Tr: TransitionJacobian<T, D> + NoisyTransition<T, D> + Sync,
     Ob: ObservationJacobian<T, D, M> + NoisyObservation<T, D, M> + Sync,
     DefaultAllocator: FilterAllocator<D, M>,
@@ -559,13 +547,8 @@ where
         z: Option<&OVector<T, M>>,
         rng: &mut R,
     ) -> Result<StepSummary<T, D>> {
-        if let Some(z) = z {
-            check_observation(z, self.observation.observation_dim())?;
-        }
-        let n = self.cloud.dim();
-        let count = self.cloud.len();
-        let mut noise: Vec<T> = Vec::new();
-        push_normals(rng, count * n, &mut noise);
+        let noise = step_noise(&self.cloud, self.observation.observation_dim(), z, rng)?;
+        let (n, count) = (self.cloud.dim(), self.cloud.len());
         let this = &*self;
         let ukf = this.ukf_stage()?;
         let moved: Vec<Moved<T, D>> = this

@@ -106,6 +106,29 @@ where
     }
 }
 
+/// The start of a step of either filter: checks the observation `z` (size `m`), then draws
+/// the standard normals of every particle's process noise (`n` per particle, in order).
+pub(crate) fn step_noise<T, D, M, R>(
+    cloud: &ParticleCloud<T, D>,
+    m: usize,
+    z: Option<&OVector<T, M>>,
+    rng: &mut R,
+) -> Result<Vec<T>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    R: Rng + ?Sized,
+    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M>,
+{
+    if let Some(z) = z {
+        check_observation(z, m)?;
+    }
+    let mut noise: Vec<T> = Vec::new();
+    push_normals(rng, cloud.len() * cloud.dim(), &mut noise);
+    Ok(noise)
+}
+
 /// Validates an observation: its size and finite values.
 pub(crate) fn check_observation<T: RealField + Copy, M: Dim>(
     z: &OVector<T, M>,
@@ -282,11 +305,8 @@ where
     _m: PhantomData<fn() -> M>,
 }
 
-impl<T, D, M, Tr, Ob> ParticleFilter<T, D, M, Tr, Ob>
+impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> ParticleFilter<T, D, M, Tr, Ob>
 where
-    T: RealField + Copy,
-    D: Dim,
-    M: Dim,
     Tr: Transition<T, D> + Sync,
     Ob: Observation<T, D, M> + Sync,
     DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M>,
@@ -364,11 +384,9 @@ where
     }
 }
 
-impl<T, D, M, Tr, Ob> ParticleFiltering<T, D, M> for ParticleFilter<T, D, M, Tr, Ob>
+impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> ParticleFiltering<T, D, M>
+    for ParticleFilter<T, D, M, Tr, Ob>
 where
-    T: RealField + Copy,
-    D: Dim,
-    M: Dim,
     Tr: Transition<T, D> + Sync,
     Ob: Observation<T, D, M> + Sync,
     DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M>,
@@ -382,13 +400,8 @@ where
         z: Option<&OVector<T, M>>,
         rng: &mut R,
     ) -> Result<StepSummary<T, D>> {
-        if let Some(z) = z {
-            check_observation(z, self.observation.observation_dim())?;
-        }
-        let n = self.cloud.dim();
-        let count = self.cloud.len();
-        let mut noise: Vec<T> = Vec::new();
-        push_normals(rng, count * n, &mut noise);
+        let noise = step_noise(&self.cloud, self.observation.observation_dim(), z, rng)?;
+        let (n, count) = (self.cloud.dim(), self.cloud.len());
         let (tr, ob, lik, qf) = (
             &self.transition,
             &self.observation,
