@@ -7,6 +7,9 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum Error {
+    /// Reading or writing a file failed (the message names the file).
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
     /// An input that must hold at least one element was empty.
     #[error("{what} is empty")]
     Empty {

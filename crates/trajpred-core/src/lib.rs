@@ -21,6 +21,7 @@
 
 pub mod error;
 pub mod gaussian;
+pub mod io;
 pub mod predictor;
 pub mod trajectory;
 pub mod window;

@@ -178,27 +178,8 @@ pub fn write_chart(chart: &Chart, path: &Path) -> Result<()> {
             reason: format!("{}: the file name must end in .svg or .png", path.display()),
         });
     }
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(
-        ".{name}.tmp-{}.{}",
-        std::process::id(),
-        ext.unwrap_or("svg")
-    ));
-    let drawn = match ext {
-        Some("svg") => draw(SVGBackend::new(&tmp, size).into_drawing_area(), chart),
-        _ => draw(BitMapBackend::new(&tmp, size).into_drawing_area(), chart),
-    };
-    let renamed = drawn.and_then(|()| {
-        std::fs::rename(&tmp, path).map_err(|e| Error::InvalidParameter {
-            name: "output",
-            reason: format!("cannot write {}: {e}", path.display()),
-        })
-    });
-    if renamed.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    renamed
+    trajpred_core::io::write_atomic_with(path, |tmp: &Path| match ext {
+        Some("svg") => draw(SVGBackend::new(tmp, size).into_drawing_area(), chart),
+        _ => draw(BitMapBackend::new(tmp, size).into_drawing_area(), chart),
+    })
 }

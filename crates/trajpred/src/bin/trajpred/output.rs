@@ -199,18 +199,8 @@ pub fn table(reports: &[MethodReport], format: Format) -> Result<String> {
     Ok(s)
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same folder, then renames it.
+/// Writes `bytes` to `path` whole or not at all ([`trajpred_core::io::write_atomic`]).
 pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(std::path::Path::new("."));
-    let name = path
-        .file_name()
-        .context("the output path names no file")?
-        .to_string_lossy();
-    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
-    std::fs::write(&tmp, bytes).with_context(|| format!("cannot write {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("cannot write {}", path.display()))?;
-    Ok(())
+    trajpred_core::io::write_atomic(path, bytes)
+        .with_context(|| format!("cannot write {}", path.display()))
 }
