@@ -130,7 +130,7 @@ fn main() -> ExitCode {
     }
     match parent() {
         Ok(()) => {
-            println!(
+            eprintln!(
                 "killed_writer: ok (old file whole after SIGKILL; new file whole after a full write)"
             );
             ExitCode::SUCCESS
