@@ -48,6 +48,7 @@ pub use burn;
 pub mod arch;
 pub mod config;
 pub mod error;
+mod fused;
 pub mod kfu;
 mod persist;
 mod train;
