@@ -179,7 +179,13 @@ impl KfuCell {
 
     /// [`KfuCell::run`] through the fused op (`src/fused/kfu.rs`): the whole filter one
     /// autodiff node, the parameters packed into one vector.
-    fn run_fused(&self, z: Tensor<3>, spec: &Spec, p0: f64, extra: usize) -> Result<FilterRun> {
+    pub(crate) fn run_fused(
+        &self,
+        z: Tensor<3>,
+        spec: &Spec,
+        p0: f64,
+        extra: usize,
+    ) -> Result<FilterRun> {
         let [b, c, d] = z.dims();
         let mut parts = Vec::new();
         for l in &self.lstm {
@@ -210,7 +216,13 @@ impl KfuCell {
     /// Filters `z: [batch, c, d]` from `y(0|0) = z(0)`, `P(0|0) = p0`, and predicts `extra`
     /// steps past the last observation: through the fused op when `spec` is given and the
     /// tensors allow it, otherwise composed of burn's tensor operations (the reference).
-    pub(crate) fn run(&self, z: Tensor<3>, p0: f64, extra: usize, spec: Option<&Spec>) -> FilterRun {
+    pub(crate) fn run(
+        &self,
+        z: Tensor<3>,
+        p0: f64,
+        extra: usize,
+        spec: Option<&Spec>,
+    ) -> FilterRun {
         if let Some(spec) = spec
             && let Ok(run) = self.run_fused(z.clone(), spec, p0, extra)
         {

@@ -69,32 +69,29 @@ pub(crate) enum Inputs {
     Plain(Vec<FlexTensor>),
 }
 
-/// Splits the primitives of an op's inputs; they must all be on the same kind of device.
-pub(crate) fn inputs(prims: Vec<Prim>) -> Result<Inputs> {
-    let n = prims.len();
-    let mut flexes = Vec::with_capacity(n);
-    let mut guards = Vec::with_capacity(n);
-    let mut plain = 0;
-    for p in prims {
-        match p {
-            Prim::Ad(t) => {
-                let (inner, guard) = t.into_parts();
-                flexes.push(inner);
-                guards.push(guard);
-            }
-            Prim::Plain(t) => {
-                flexes.push(t);
-                plain += 1;
-            }
-        }
+/// Splits the primitives of an op's inputs. When any input is on the autodiff device, the
+/// plain ones join as untracked constants (as burn's own operations treat them), so a
+/// network of plain weights (`Module::valid`) reading autodiff data still runs fused.
+pub(crate) fn inputs(prims: Vec<Prim>) -> Inputs {
+    if prims.iter().all(|p| matches!(p, Prim::Plain(_))) {
+        return Inputs::Plain(
+            prims
+                .into_iter()
+                .filter_map(|p| match p {
+                    Prim::Plain(t) => Some(t),
+                    Prim::Ad(_) => None,
+                })
+                .collect(),
+        );
     }
-    match plain {
-        0 => Ok(Inputs::Ad(flexes, guards)),
-        p if p == n => Ok(Inputs::Plain(flexes)),
-        _ => Err(NeuralError::Tensor {
-            reason: "fused op: inputs mix autodiff and plain tensors".into(),
-        }),
-    }
+    let (flexes, guards) = prims
+        .into_iter()
+        .map(|p| match p {
+            Prim::Ad(t) => t.into_parts(),
+            Prim::Plain(t) => AdTensor::new(t).into_parts(),
+        })
+        .unzip();
+    Inputs::Ad(flexes, guards)
 }
 
 /// Registers `grad` (`shape`) for a parent node if it requires a gradient.

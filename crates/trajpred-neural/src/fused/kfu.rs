@@ -103,6 +103,7 @@ impl Spec {
     }
 
     /// Length of the packed parameter vector.
+    #[cfg(test)]
     pub(crate) fn n_params(&self) -> usize {
         self.offsets().total
     }
@@ -182,7 +183,11 @@ pub(crate) fn forward<T: Real>(
         return Err(mismatch("fused KFU parameters", off.total, params.len()));
     }
     if c == 0 || z.len() != batch * c * d {
-        return Err(mismatch("fused KFU observations", batch * c.max(1) * d, z.len()));
+        return Err(mismatch(
+            "fused KFU observations",
+            batch * c.max(1) * d,
+            z.len(),
+        ));
     }
     let steps = c - 1 + extra;
     let rows = steps * batch;
@@ -357,10 +362,7 @@ pub(crate) fn backward<T: Real>(
     let d = spec.d;
     let off = spec.offsets();
     let Cache {
-        batch,
-        c,
-        steps,
-        ..
+        batch, c, steps, ..
     } = *cache;
     if g.len() != batch * steps * 2 * d || params.len() != off.total {
         return Err(NeuralError::DimensionMismatch {
@@ -378,9 +380,17 @@ pub(crate) fn backward<T: Real>(
         .iter()
         .map(|l| vec![zero; rows * 4 * l.hidden])
         .collect();
-    let mut dh_next: Vec<Vec<T>> = off.lstm.iter().map(|l| vec![zero; batch * l.hidden]).collect();
+    let mut dh_next: Vec<Vec<T>> = off
+        .lstm
+        .iter()
+        .map(|l| vec![zero; batch * l.hidden])
+        .collect();
     let mut dc: Vec<Vec<T>> = dh_next.clone();
-    let mut gpre: Vec<Vec<T>> = off.head.iter().map(|l| vec![zero; rows * l.output]).collect();
+    let mut gpre: Vec<Vec<T>> = off
+        .head
+        .iter()
+        .map(|l| vec![zero; rows * l.output])
+        .collect();
     let mut gq = vec![zero; d];
     let mut gr = vec![zero; d];
     let mut g_p = vec![zero; d];
@@ -592,7 +602,12 @@ impl Backward<Flex, 2> for SequenceBackward {
             params: vec![f32::NAN; state.params.len()],
             z: Some(vec![f32::NAN; batch * c * d]),
         });
-        bridge::register(grads, z_id.as_ref(), g.z.unwrap_or_default(), &[batch, c, d]);
+        bridge::register(
+            grads,
+            z_id.as_ref(),
+            g.z.unwrap_or_default(),
+            &[batch, c, d],
+        );
         let n = g.params.len();
         bridge::register(grads, p_id.as_ref(), g.params, &[n]);
     }
@@ -637,7 +652,7 @@ pub(crate) fn sequence(
             },
         ))
     };
-    match bridge::inputs(prims)? {
+    match bridge::inputs(prims) {
         Inputs::Plain(t) => {
             let (out, _) = run(&t)?;
             Ok(Tensor::from_primitive::<Flex>(bridge::flex(out, &shape)))

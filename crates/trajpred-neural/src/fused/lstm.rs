@@ -283,7 +283,13 @@ impl Backward<Flex, 4> for LayerBackward {
             vec![hidden, 4 * hidden],
         ];
         let result = bridge::values(&grad, "LSTM output gradient").and_then(|dh| {
-            backward(&state.cache, &state.w_ih, &state.w_hh, &dh, ids[0].is_some())
+            backward(
+                &state.cache,
+                &state.w_ih,
+                &state.w_hh,
+                &dh,
+                ids[0].is_some(),
+            )
         });
         // An internal inconsistency (not reachable with the shapes checked in the forward
         // pass) leaves NaN gradients, which the training loop reports as divergence.
@@ -345,18 +351,16 @@ pub(crate) fn layer(
             },
         ))
     };
-    match bridge::inputs(prims)? {
+    match bridge::inputs(prims) {
         Inputs::Plain(t) => {
             let (out, _) = run(&t)?;
             Ok(Tensor::from_primitive::<Flex>(bridge::flex(out, &shape)))
         }
         Inputs::Ad(t, guards) => {
             let (out, state) = run(&t)?;
-            let nodes: [_; 4] = guards
-                .try_into()
-                .map_err(|_| NeuralError::Tensor {
-                    reason: "fused LSTM: expected four inputs".into(),
-                })?;
+            let nodes: [_; 4] = guards.try_into().map_err(|_| NeuralError::Tensor {
+                reason: "fused LSTM: expected four inputs".into(),
+            })?;
             let out = bridge::flex(out, &shape);
             let ad = match LayerBackward
                 .prepare::<NoCheckpointing>(nodes)

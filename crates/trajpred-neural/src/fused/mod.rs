@@ -71,7 +71,11 @@ impl<'a, T> Mat<'a, T> {
     fn view(self) -> Result<ArrayView2<'a, T>> {
         let v = ArrayView2::from_shape((self.rows, self.cols), self.data)
             .map_err(|_| shape_error("a matrix operand"))?;
-        Ok(if self.transposed { v.reversed_axes() } else { v })
+        Ok(if self.transposed {
+            v.reversed_axes()
+        } else {
+            v
+        })
     }
 }
 
@@ -151,7 +155,11 @@ pub(crate) fn cell_backward<T: Real>(
 ) {
     let g4 = 4 * h;
     let one = T::one();
-    for (r, (gt, dat)) in gates.chunks_exact(g4).zip(da.chunks_exact_mut(g4)).enumerate() {
+    for (r, (gt, dat)) in gates
+        .chunks_exact(g4)
+        .zip(da.chunks_exact_mut(g4))
+        .enumerate()
+    {
         for j in 0..h {
             let (i, f, g, o) = (gt[j], gt[h + j], gt[2 * h + j], gt[3 * h + j]);
             let k = r * h + j;

@@ -69,10 +69,7 @@ fn tensor<const D: usize>(v: Vec<f32>, dims: [usize; D], device: &Device) -> Ten
 fn assert_close(a: &[f32], b: &[f32], tol: f32, what: &str) {
     assert_eq!(a.len(), b.len(), "{what}: lengths");
     let scale = b.iter().fold(0f32, |m, v| m.max(v.abs())).max(1e-6);
-    let err = a
-        .iter()
-        .zip(b)
-        .fold(0f32, |m, (x, y)| m.max((x - y).abs()));
+    let err = a.iter().zip(b).fold(0f32, |m, (x, y)| m.max((x - y).abs()));
     assert!(
         err <= tol * scale,
         "{what}: max |fused - reference| = {err:e} > {tol:e} x {scale:e}"
@@ -83,7 +80,10 @@ fn assert_close(a: &[f32], b: &[f32], tol: f32, what: &str) {
 /// depend on (`W_hh` over a single step), where the fused op registers zeros.
 fn assert_param(fused: &[f32], reference: &[f32], what: &str) {
     if reference.is_empty() {
-        assert!(fused.iter().all(|v| *v == 0.0), "{what}: expected no gradient");
+        assert!(
+            fused.iter().all(|v| *v == 0.0),
+            "{what}: expected no gradient"
+        );
     } else {
         assert_close(fused, reference, GRAD_TOL, what);
     }
@@ -136,7 +136,11 @@ fn lstm_layer_gradients_equal_the_composed_reference() {
         assert_close(&gx, &gx_ref, GRAD_TOL, &format!("{what}: dx"));
         let g_ref = GradientsParams::from_grads(g_ref_all, &layer);
         let g = GradientsParams::from_grads(g_all, &layer);
-        for (k, (a, e)) in collect(&g, &layer).iter().zip(collect(&g_ref, &layer)).enumerate() {
+        for (k, (a, e)) in collect(&g, &layer)
+            .iter()
+            .zip(collect(&g_ref, &layer))
+            .enumerate()
+        {
             assert_param(a, &e, &format!("{what}: parameter {k}"));
         }
     }
@@ -278,12 +282,7 @@ fn kfu_gradients_equal_the_composed_reference() {
 
 /// Central differences of `loss(v) = Σ w ⊙ forward(v)` in f64, compared with an analytic
 /// gradient: `|fd - analytic| <= 1e-6 (1 + |analytic|)`.
-fn check_fd(
-    what: &str,
-    v: &[f64],
-    analytic: &[f64],
-    mut loss: impl FnMut(&[f64]) -> f64,
-) {
+fn check_fd(what: &str, v: &[f64], analytic: &[f64], mut loss: impl FnMut(&[f64]) -> f64) {
     assert_eq!(v.len(), analytic.len(), "{what}: lengths");
     let eps = 1e-6;
     let mut p = v.to_vec();
@@ -341,7 +340,9 @@ fn lstm_backward_equals_finite_differences() {
         check_fd(&format!("{what}: dW_ih"), &w_ih, &g.dw_ih, |p| {
             f(&x, p, &bias, &w_hh)
         });
-        check_fd(&format!("{what}: db"), &bias, &g.db, |p| f(&x, &w_ih, p, &w_hh));
+        check_fd(&format!("{what}: db"), &bias, &g.db, |p| {
+            f(&x, &w_ih, p, &w_hh)
+        });
         check_fd(&format!("{what}: dW_hh"), &w_hh, &g.dw_hh, |p| {
             f(&x, &w_ih, &bias, p)
         });
@@ -379,11 +380,79 @@ fn kfu_backward_equals_finite_differences() {
         let g = kfu::backward(&spec, &cache, &z, &params, &w, true).expect("shapes");
         let what = format!("seed {seed}: {spec:?} B {b} c {c} extra {extra}");
         let f = |z: &[f64], p: &[f64]| {
-            dot(&kfu::forward(&spec, z, b, c, p, p0, extra).expect("shapes").0, &w)
+            dot(
+                &kfu::forward(&spec, z, b, c, p, p0, extra)
+                    .expect("shapes")
+                    .0,
+                &w,
+            )
         };
-        check_fd(&format!("{what}: parameters"), &params, &g.params, |p| f(&z, p));
+        check_fd(&format!("{what}: parameters"), &params, &g.params, |p| {
+            f(&z, p)
+        });
         check_fd(&format!("{what}: dz"), &z, &g.z.unwrap_or_default(), |p| {
             f(p, &params)
         });
+    }
+}
+
+/// Inference: a network of plain weights (`Module::valid`) reading data on the autodiff
+/// device runs through the fused ops (no fallback to the composed path), with the outputs of
+/// the composed path.
+#[test]
+fn plain_weights_with_autodiff_data_run_fused() {
+    let device = device();
+    let mut r = rng(1, 12);
+    let layer = FusedLstm::new(2, 3, &device)
+        .map(&mut Fill {
+            rng: &mut r,
+            scale: 0.5,
+        })
+        .valid();
+    let x = tensor(uniform(&mut r, 2 * 4 * 2, 1.0), [2, 4, 2], &device);
+    let (w_ih, bias, w_hh) = layer.fused_params();
+    let out = lstm::layer(x.clone(), w_ih, bias, w_hh).expect("runs fused");
+    let (out_ref, _) = layer.forward(x, None);
+    assert_close(
+        &read(out).expect("f32"),
+        &read(out_ref).expect("f32"),
+        OUT_TOL,
+        "LSTM layer",
+    );
+    let cfg = KfuConfig {
+        layers: vec![3],
+        fc: vec![],
+        ..KfuConfig::default()
+    };
+    let cell = KfuCell::new(&cfg, 2, &device)
+        .map(&mut Fill {
+            rng: &mut r,
+            scale: 0.5,
+        })
+        .valid();
+    let spec = kfu::Spec {
+        d: 2,
+        layers: vec![3],
+        fc: vec![],
+        activation: cfg.activation,
+    };
+    let z = tensor(uniform(&mut r, 2 * 5 * 2, 1.0), [2, 5, 2], &device);
+    let run = cell
+        .run_fused(z.clone(), &spec, 1.0, 2)
+        .expect("runs fused");
+    let run_ref = cell.run(z, 1.0, 2, None);
+    assert_close(
+        &read(run.posteriors).expect("f32"),
+        &read(run_ref.posteriors).expect("f32"),
+        OUT_TOL,
+        "KFU posteriors",
+    );
+    for (a, e) in run.ahead.into_iter().zip(run_ref.ahead) {
+        assert_close(
+            &read(a).expect("f32"),
+            &read(e).expect("f32"),
+            OUT_TOL,
+            "ahead",
+        );
     }
 }
