@@ -113,7 +113,7 @@ fn activate<T: Real>(a: Activation, v: &mut [T]) {
     for x in v {
         *x = match a {
             Activation::Relu => x.max(T::zero()),
-            Activation::Tanh => x.tanh(),
+            Activation::Tanh => super::tanh(*x),
             Activation::Sigmoid => super::sigmoid(*x),
         };
     }

@@ -106,7 +106,10 @@ pub(crate) fn forward<T: Real>(
     check_len(w_hh, hidden * g4, "fused LSTM recurrent weights")?;
     let xt = swap_01(x, batch, steps, input);
     let rows = dims.rows();
-    let mut gates: Vec<T> = b.iter().copied().cycle().take(rows * g4).collect();
+    let mut gates = vec![T::zero(); rows * g4];
+    for row in gates.chunks_exact_mut(g4) {
+        row.copy_from_slice(b);
+    }
     gemm(
         Mat::new(&xt, rows, input),
         Mat::new(w_ih, input, g4),
