@@ -13,6 +13,9 @@
 //!
 //! `cargo run --release -p trajpred-neural --example speed -- lstm|kfu [fused|composed] [warmup] [repeat]`
 
+// the JSON line on standard output is this program's result (read by benches/compare.sh)
+#![allow(clippy::print_stdout)]
+
 use trajpred_core::Trajectory;
 use trajpred_neural::{
     AxisMode, KfuConfig, KfuLstmNet, LstmArch, LstmNet, RecurrentLayers, TrainConfig, WindowConfig,
