@@ -14,8 +14,8 @@ The same network and data as our `LstmNet` bench:
 - Adam lr 1e-3, epsilon 1e-8, MSE loss, float32; the loss is read back every batch
   (`loss.item()`), as our loop does to detect divergence.
 
-Timing: `--warmup` epochs are dropped, then the median (and min/max) wall time of
-`--repeat` epochs (time.perf_counter) is printed. Run each thread setting in its own process:
+Timing: `--warmup` epochs are dropped, then the median, quartiles, min and max of the wall
+times (time.perf_counter) of `--repeat` epochs are printed (never the minimum alone). Run each thread setting in its own process:
 
     python pytorch_lstm_epoch.py --threads 1
     python pytorch_lstm_epoch.py --threads 0      # 0 = PyTorch's default thread count
@@ -105,7 +105,10 @@ def main():
         losses.append(loss)
         if i >= a.warmup:
             times.append(dt)
+    q = statistics.quantiles(times, n=4, method="inclusive")
     res = {
+        "impl": "torch",
+        "workload": "lstm",
         "torch": torch.__version__,
         "threads": torch.get_num_threads(),
         "mkldnn": torch.backends.mkldnn.enabled,
@@ -113,6 +116,8 @@ def main():
         "warmup": a.warmup,
         "repeat": a.repeat,
         "median_s": statistics.median(times),
+        "p25_s": q[0],
+        "p75_s": q[2],
         "min_s": min(times),
         "max_s": max(times),
         "first_loss": losses[0],
@@ -124,7 +129,8 @@ def main():
         print(
             f"torch {res['torch']}, {res['threads']} thread(s), mkldnn {res['mkldnn']}, "
             f"{batches} batches/epoch: median {res['median_s']:.4f} s/epoch "
-            f"[min {res['min_s']:.4f}, max {res['max_s']:.4f}] over {a.repeat} epochs "
+            f"[p25 {res['p25_s']:.4f}, p75 {res['p75_s']:.4f}; min {res['min_s']:.4f}, "
+            f"max {res['max_s']:.4f}] over {a.repeat} epochs "
             f"after {a.warmup} warm-up; loss {losses[0]:.4f} -> {losses[-1]:.4f}"
         )
 

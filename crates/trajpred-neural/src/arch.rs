@@ -4,7 +4,7 @@
 //! Every architecture maps a batch of windows `[batch, m, features]` to a batch of direct
 //! multi-step outputs `[batch, T * features]`.
 
-use crate::config::Activation;
+use crate::config::{Activation, TrainConfig};
 use crate::error::{NeuralError, Result};
 use burn::module::Module;
 use burn::nn::{Linear, LinearConfig, Rnn, RnnConfig};
@@ -31,6 +31,11 @@ pub trait Architecture:
     fn build(&self, features: usize, window: usize, outputs: usize, device: &Device) -> Self::Net;
     /// `[batch, window, features]` -> `[batch, outputs]`.
     fn forward(&self, net: &Self::Net, x: Tensor<3>) -> Tensor<2>;
+    /// Applies the choices of the training configuration that live in the network (the
+    /// LSTM's [`TrainConfig::fused`]); the default keeps the network as it is.
+    fn configure(&self, net: Self::Net, _train: &TrainConfig) -> Self::Net {
+        net
+    }
 }
 
 pub(crate) fn activate(a: Activation, x: Tensor<2>) -> Tensor<2> {
@@ -85,6 +90,23 @@ impl Head {
             out: LinearConfig::new(d, outputs).init(device),
             activation,
         }
+    }
+
+    /// Every weight and bias flattened, layer by layer (`W` `[in, out]` row-major, then `b`,
+    /// zeros without a bias), the output layer last: the packing of the fused KFU op.
+    pub(crate) fn fused_params(&self) -> Vec<Tensor<1>> {
+        let mut v = Vec::with_capacity(2 * self.hidden.len() + 2);
+        for l in self.hidden.iter().chain(std::iter::once(&self.out)) {
+            let w = l.weight.val();
+            let [i, o] = w.dims();
+            let device = w.device();
+            v.push(w.reshape([i * o]));
+            v.push(match &l.bias {
+                Some(b) => b.val(),
+                None => Tensor::zeros([o], &device),
+            });
+        }
+        v
     }
 
     pub(crate) fn forward(&self, mut x: Tensor<2>) -> Tensor<2> {
@@ -179,6 +201,8 @@ pub struct RnnStack {
 pub struct LstmStack {
     layers: Vec<FusedLstm>,
     head: Head,
+    /// Each layer through one fused op (`src/fused/lstm.rs`) instead of step by step.
+    fused: bool,
 }
 
 /// One LSTM layer with the four gates fused into one input and one recurrent matrix
@@ -272,6 +296,17 @@ impl FusedLstm {
         LstmCellState { cell, hidden }
     }
 
+    /// `W_ih` `[d_input, 4 hidden]`, `b` `[4 hidden]` (zeros without a bias) and `W_hh`
+    /// `[hidden, 4 hidden]`: the weights as the fused ops take them.
+    pub(crate) fn fused_params(&self) -> (Tensor<2>, Tensor<1>, Tensor<2>) {
+        let w_ih = self.input.weight.val();
+        let b = match &self.input.bias {
+            Some(b) => b.val(),
+            None => Tensor::zeros([4 * self.d_hidden], &w_ih.device()),
+        };
+        (w_ih, b, self.recurrent.weight.val())
+    }
+
     /// One step on input `x: [batch, d_input]`.
     pub fn forward_step(&self, x: Tensor<2>, state: Option<LstmCellState>) -> LstmCellState {
         let scale = self.gate_scale(&x.device());
@@ -308,6 +343,17 @@ impl FusedLstm {
         });
         (Tensor::stack(outs, 1), last)
     }
+}
+
+/// The last hidden state of stacked layers, each layer one fused op over the window; `None`
+/// when the tensors are not on the flex backend (then the composed path runs).
+fn fused_stack(layers: &[FusedLstm], mut x: Tensor<3>) -> Option<Tensor<2>> {
+    for l in layers {
+        let (w_ih, b, w_hh) = l.fused_params();
+        x = crate::fused::lstm::layer(x, w_ih, b, w_hh).ok()?;
+    }
+    let [b, m, h] = x.dims();
+    (m > 0).then(|| x.slice([0..b, m - 1..m, 0..h]).reshape([b, h]))
 }
 
 impl Architecture for RnnArch {
@@ -362,12 +408,22 @@ impl Architecture for LstmArch {
         LstmStack {
             layers,
             head: Head::new(d, &self.0.fc, outputs, self.0.activation, device),
+            fused: true,
         }
+    }
+    fn configure(&self, mut net: LstmStack, train: &TrainConfig) -> LstmStack {
+        net.fused = train.fused;
+        net
     }
     /// Step by step through all layers at once (layer `l` at step `t` reads layer `l - 1`
     /// at step `t`): only the last layer's final hidden state is used, so no layer's
     /// sequence of hidden states is stacked and sliced again.
     fn forward(&self, net: &LstmStack, x: Tensor<3>) -> Tensor<2> {
+        if net.fused
+            && let Some(h) = fused_stack(&net.layers, x.clone())
+        {
+            return net.head.forward(h);
+        }
         let [b, m, f] = x.dims();
         let mut states: Vec<Option<LstmCellState>> = vec![None; net.layers.len()];
         let scales: Vec<Tensor<2>> = net

@@ -78,6 +78,17 @@ pub struct TrainConfig {
     pub early_stopping: Option<EarlyStopping>,
     /// Optional clipping of the gradient's global L2 norm.
     pub grad_clip_norm: Option<f64>,
+    /// Whether the LSTM and the KFU-LSTM-Net run through the fused ops with their own
+    /// backward pass (one autodiff node per LSTM layer / per unrolled filter) instead of
+    /// burn's per-operation autodiff, the reference. The same weights give the same
+    /// predictions either way up to `f32` rounding (see `docs/neural.md`). Default `true`;
+    /// the other models ignore it.
+    #[serde(default = "fused_default")]
+    pub fused: bool,
+}
+
+fn fused_default() -> bool {
+    true
 }
 
 impl TrainConfig {
@@ -91,7 +102,14 @@ impl TrainConfig {
             seed: 0,
             early_stopping: None,
             grad_clip_norm: None,
+            fused: true,
         }
+    }
+
+    /// Turns the fused LSTM / KFU ops on or off (off: burn's per-operation autodiff).
+    pub fn with_fused(mut self, fused: bool) -> Self {
+        self.fused = fused;
+        self
     }
 
     /// Sets the number of epochs.

@@ -8,6 +8,7 @@
 use crate::arch::{FusedLstm, Head, LstmCellState};
 use crate::config::{Activation, EpochReport, TrainConfig, TrainReport};
 use crate::error::{NeuralError, Result};
+use crate::fused::{self, kfu::Spec};
 use crate::persist;
 use crate::train::{
     LoopSpec, Standardizer, XavierZeroBias, check_finite, device, mse, read, rng, train_loop,
@@ -137,18 +138,18 @@ pub struct KfuCell {
 }
 
 /// What one run of the filter over a batch of sequences produced (standardised units).
-struct FilterRun {
+pub(crate) struct FilterRun {
     /// `y(t|t-1)` for `t = 1..c-1`: `[batch, c-1, d]`.
-    priors: Tensor<3>,
+    pub(crate) priors: Tensor<3>,
     /// `y(t|t)` for `t = 1..c-1`: `[batch, c-1, d]`.
-    posteriors: Tensor<3>,
+    pub(crate) posteriors: Tensor<3>,
     /// The one-step-ahead prior after the last observation, then further steps without
     /// update: `extra` tensors `[batch, d]`.
-    ahead: Vec<Tensor<2>>,
+    pub(crate) ahead: Vec<Tensor<2>>,
 }
 
 impl KfuCell {
-    fn new(cfg: &KfuConfig, d: usize, device: &Device) -> Self {
+    pub(crate) fn new(cfg: &KfuConfig, d: usize, device: &Device) -> Self {
         let mut lstm = Vec::new();
         let mut h = d;
         for &size in &cfg.layers {
@@ -176,9 +177,57 @@ impl KfuCell {
         x + self.head.forward(inp)
     }
 
+    /// [`KfuCell::run`] through the fused op (`src/fused/kfu.rs`): the whole filter one
+    /// autodiff node, the parameters packed into one vector.
+    pub(crate) fn run_fused(
+        &self,
+        z: Tensor<3>,
+        spec: &Spec,
+        p0: f64,
+        extra: usize,
+    ) -> Result<FilterRun> {
+        let [b, c, d] = z.dims();
+        let mut parts = Vec::new();
+        for l in &self.lstm {
+            let (w_ih, bias, w_hh) = l.fused_params();
+            let ([i, g], [h, _]) = (w_ih.dims(), w_hh.dims());
+            parts.extend([w_ih.reshape([i * g]), bias, w_hh.reshape([h * g])]);
+        }
+        parts.extend(self.head.fused_params());
+        parts.extend([self.noise.log_q.val(), self.noise.log_r.val()]);
+        let out = fused::kfu::sequence(z, Tensor::cat(parts, 0), spec, p0, extra)?;
+        let n = c.saturating_sub(1);
+        let part = |from: usize, to: usize, k: usize| {
+            if to > from {
+                out.clone().slice([0..b, from..to, k * d..(k + 1) * d])
+            } else {
+                Tensor::<3>::zeros([b, 0, d], &out.device())
+            }
+        };
+        Ok(FilterRun {
+            priors: part(0, n, 0),
+            posteriors: part(0, n, 1),
+            ahead: (n..n + extra)
+                .map(|t| part(t, t + 1, 0).reshape([b, d]))
+                .collect(),
+        })
+    }
+
     /// Filters `z: [batch, c, d]` from `y(0|0) = z(0)`, `P(0|0) = p0`, and predicts `extra`
-    /// steps past the last observation.
-    fn run(&self, z: Tensor<3>, p0: f64, extra: usize) -> FilterRun {
+    /// steps past the last observation: through the fused op when `spec` is given and the
+    /// tensors allow it, otherwise composed of burn's tensor operations (the reference).
+    pub(crate) fn run(
+        &self,
+        z: Tensor<3>,
+        p0: f64,
+        extra: usize,
+        spec: Option<&Spec>,
+    ) -> FilterRun {
+        if let Some(spec) = spec
+            && let Ok(run) = self.run_fused(z.clone(), spec, p0, extra)
+        {
+            return run;
+        }
         let [b, c, d] = z.dims();
         let device = z.device();
         let q = self.noise.log_q.val().exp().unsqueeze::<2>();
@@ -287,6 +336,16 @@ impl KfuLstmNet {
             KfuConfig::default(),
             TrainConfig::new(1e-4).with_epochs(300).with_batch_size(16),
         )
+    }
+
+    /// The sizes of the fused filter op when training config asks for it.
+    fn spec(&self, d: usize) -> Option<Spec> {
+        self.train.fused.then(|| Spec {
+            d,
+            layers: self.config.layers.clone(),
+            fc: self.config.fc.clone(),
+            activation: self.config.activation,
+        })
     }
 
     /// The architecture and filter settings.
@@ -464,11 +523,13 @@ impl KfuLstmNet {
         let cell = self.init_cell(dim, &device);
         let p0 = self.config.p0;
         let supervised = truth.is_some();
+        let spec = self.spec(dim);
+        let spec = spec.as_ref();
         let dev = &device;
         let loss_of = move |cell: &KfuCell, zo: &[f32], zt: &[f32], b: usize| {
             let z = Tensor::<3>::from_data(TensorData::new(zo.to_vec(), [b, len, dim]), dev);
             let y = Tensor::<3>::from_data(TensorData::new(zt.to_vec(), [b, len, dim]), dev);
-            let run = cell.run(z, p0, 0);
+            let run = cell.run(z, p0, 0, spec);
             let y1 = y.slice([0..b, 1..len, 0..dim]);
             if supervised {
                 mse(run.posteriors, y1.clone()) + mse(run.priors, y1) * 0.5
@@ -553,7 +614,7 @@ impl KfuLstmNet {
         }
         let device = device();
         let z = Tensor::<3>::from_data(TensorData::new(z, [1, c, dim]), &device);
-        let run = cell.run(z, self.config.p0, horizon);
+        let run = cell.run(z, self.config.p0, horizon, self.spec(dim).as_ref());
         let mut out = Vec::with_capacity(horizon);
         for (s, t) in run.ahead.into_iter().enumerate() {
             let v = read(t)?;
@@ -594,6 +655,7 @@ impl KfuLstmNet {
             });
         }
         let l = self.config.seq_len;
+        let spec = self.spec(dim);
         let zs: Vec<f32> = (0..n)
             .flat_map(|i| (0..dim).map(move |k| (i, k)))
             .map(|(i, k)| f.scaler.forward(k, observed.axis(k)[i]) as f32)
@@ -611,7 +673,7 @@ impl KfuLstmNet {
             TensorData::new(zs[..c * dim].to_vec(), [1, c, dim]),
             &device,
         );
-        let run = cell.run(z, self.config.p0, 1);
+        let run = cell.run(z, self.config.p0, 1, spec.as_ref());
         let priors = read(run.priors)?;
         for t in 0..c - 1 {
             out.push(de(&priors[t * dim..(t + 1) * dim]));
@@ -629,7 +691,7 @@ impl KfuLstmNet {
                 v.extend_from_slice(&zs[(i + 1 - l) * dim..(i + 1) * dim]);
             }
             let z = Tensor::<3>::from_data(TensorData::new(v, [chunk.len(), l, dim]), &device);
-            let run = cell.run(z, self.config.p0, 1);
+            let run = cell.run(z, self.config.p0, 1, spec.as_ref());
             if let Some(a) = run.ahead.into_iter().next() {
                 let vals = read(a)?;
                 for b in 0..chunk.len() {

@@ -1,7 +1,10 @@
 //! # trajpred-neural
 //!
 //! The neural baselines of the trajpred papers on [burn](https://burn.dev) 0.22.1 with its
-//! pure-Rust `flex` CPU backend and autodiff (no gradient written by hand):
+//! pure-Rust `flex` CPU backend and autodiff. The LSTM layers and the unrolled KFU filter
+//! train through fused autodiff ops with their own backward pass (`TrainConfig::fused`,
+//! default on), held by tests to burn's autodiff through the composed models, which stay as
+//! the reference (`TrainConfig::with_fused(false)`):
 //!
 //! - [`Mlp`] (the GSKF paper's "BP"), [`RnnNet`] and [`LstmNet`]: instances of
 //!   [`WindowNet`], mapping the last `m` points to the next `T` points (direct multi-step
@@ -48,6 +51,7 @@ pub use burn;
 pub mod arch;
 pub mod config;
 pub mod error;
+mod fused;
 pub mod kfu;
 mod persist;
 mod train;

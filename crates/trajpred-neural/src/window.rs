@@ -219,7 +219,8 @@ impl<A: Architecture> WindowNet<A> {
         let (f, out) = self.shape(dim);
         let net = self.arch.build(f, self.layout.window, out, device);
         let mut r = rng(self.train.seed, seed_stream);
-        net.map(&mut XavierZeroBias { rng: &mut r })
+        let net = net.map(&mut XavierZeroBias { rng: &mut r });
+        self.arch.configure(net, &self.train)
     }
 
     /// Trains on `train` (each trajectory's sliding windows), calling `progress` after every

@@ -1,0 +1,107 @@
+//! Between burn's tensors and the fused arithmetic: the `flex` backend's `f32` storage,
+//! with or without autodiff.
+
+use crate::error::{NeuralError, Result};
+use burn::backend::autodiff::grads::Gradients;
+use burn::backend::autodiff::ops::NodeGuard;
+use burn::backend::flex::FlexTensor;
+use burn::backend::tensor::FloatTensor;
+use burn::backend::{Autodiff, Flex};
+use burn::tensor::{DType, Tensor, TensorData};
+use std::borrow::Cow;
+
+/// An autodiff float primitive of the flex backend.
+pub(crate) type AdTensor = FloatTensor<Autodiff<Flex>>;
+
+/// A tensor's primitive: tracked by autodiff (on an autodiff device) or plain flex.
+pub(crate) enum Prim {
+    /// On an autodiff device (tracked or not).
+    Ad(AdTensor),
+    /// On the plain flex device (inference).
+    Plain(FlexTensor),
+}
+
+fn not_flex(what: &str) -> NeuralError {
+    NeuralError::Tensor {
+        reason: format!("fused op: {what} is not an f32 tensor of the flex backend"),
+    }
+}
+
+/// The primitive of a tensor of the flex backend (with or without autodiff).
+pub(crate) fn prim<const D: usize>(t: Tensor<D>, what: &str) -> Result<Prim> {
+    if t.dtype() != DType::F32 {
+        return Err(not_flex(what));
+    }
+    match t.clone().try_into_primitive::<Autodiff<Flex>>() {
+        Ok(p) => Ok(Prim::Ad(p)),
+        Err(_) => t
+            .try_into_primitive::<Flex>()
+            .map(Prim::Plain)
+            .map_err(|_| not_flex(what)),
+    }
+}
+
+/// The `f32` values of a flex tensor in row-major order: borrowed when it is contiguous.
+pub(crate) fn values<'a>(t: &'a FlexTensor, what: &str) -> Result<Cow<'a, [f32]>> {
+    if t.dtype() != DType::F32 {
+        return Err(not_flex(what));
+    }
+    match t.as_slice::<f32>() {
+        Some(s) => Ok(Cow::Borrowed(s)),
+        None => t
+            .to_contiguous()
+            .as_slice::<f32>()
+            .map(|s| Cow::Owned(s.to_vec()))
+            .ok_or_else(|| not_flex(what)),
+    }
+}
+
+/// A contiguous flex tensor owning `v`.
+pub(crate) fn flex(v: Vec<f32>, shape: &[usize]) -> FlexTensor {
+    FlexTensor::from_data(TensorData::new(v, shape.to_vec()))
+}
+
+/// Primitives split into values and node guards, all on the autodiff device or all plain.
+pub(crate) enum Inputs {
+    /// On the autodiff device: the inner flex primitives and the guards of their nodes.
+    Ad(Vec<FlexTensor>, Vec<NodeGuard>),
+    /// Plain flex tensors.
+    Plain(Vec<FlexTensor>),
+}
+
+/// Splits the primitives of an op's inputs. When any input is on the autodiff device, the
+/// plain ones join as untracked constants (as burn's own operations treat them), so a
+/// network of plain weights (`Module::valid`) reading autodiff data still runs fused.
+pub(crate) fn inputs(prims: Vec<Prim>) -> Inputs {
+    if prims.iter().all(|p| matches!(p, Prim::Plain(_))) {
+        return Inputs::Plain(
+            prims
+                .into_iter()
+                .filter_map(|p| match p {
+                    Prim::Plain(t) => Some(t),
+                    Prim::Ad(_) => None,
+                })
+                .collect(),
+        );
+    }
+    let (flexes, guards) = prims
+        .into_iter()
+        .map(|p| match p {
+            Prim::Ad(t) => t.into_parts(),
+            Prim::Plain(t) => AdTensor::new(t).into_parts(),
+        })
+        .unzip();
+    Inputs::Ad(flexes, guards)
+}
+
+/// Registers `grad` (`shape`) for a parent node if it requires a gradient.
+pub(crate) fn register(
+    grads: &mut Gradients,
+    parent: Option<&burn::backend::autodiff::NodeId>,
+    grad: Vec<f32>,
+    shape: &[usize],
+) {
+    if let Some(id) = parent {
+        grads.register::<Flex>(*id, flex(grad, shape));
+    }
+}
