@@ -60,12 +60,32 @@ impl<Tr, Ob> Kf<Tr, Ob> {
         Ob: LinearObservationModel<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,
     {
+        self.predictor_step_checked(prediction, z, InputChecks::Full)
+    }
+
+    /// [`Kf::predictor_step`] with the input checks `checks`: the recursions below check the
+    /// caller's state fully once and their own outputs cheaply (shapes, finite values,
+    /// symmetry; an output of eq. 15 is positive semi-definite by construction).
+    fn predictor_step_checked<T: RealField + Copy, D: Dim, M: Dim>(
+        &self,
+        prediction: &Gaussian<T, D>,
+        z: Option<&OVector<T, M>>,
+        checks: InputChecks,
+    ) -> Result<Gaussian<T, D>>
+    where
+        Tr: LinearTransitionModel<T, D>,
+        Ob: LinearObservationModel<T, D, M>,
+        DefaultAllocator: FilterAllocator<D, M>,
+    {
         let Some(z) = z else {
-            return self.predict(prediction);
+            return match checks {
+                InputChecks::Full => self.predict(prediction),
+                _ => self.predict_own_output(prediction),
+            };
         };
         let tr = self.transition();
         let ob = self.observation();
-        validate_state(prediction, tr.state_dim(), InputChecks::Full)?;
+        validate_state(prediction, tr.state_dim(), checks)?;
         check_dim("observation", ob.observation_dim(), z.nrows())?;
         check_finite(z, "observation")?;
         let a = tr.transition_matrix();
@@ -104,9 +124,13 @@ impl<Tr, Ob> Kf<Tr, Ob> {
         Ob: LinearObservationModel<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,
     {
-        scan(observations, |prev: Option<&Gaussian<T, D>>, z| {
-            self.predictor_step(prev.unwrap_or(first_prediction), z.as_ref())
-        })
+        scan(
+            observations,
+            |prev: Option<&Gaussian<T, D>>, z| match prev {
+                Some(prev) => self.predictor_step_checked(prev, z.as_ref(), InputChecks::Cheap),
+                None => self.predictor_step(first_prediction, z.as_ref()),
+            },
+        )
     }
 
     /// The `steps`-step forecast `N(X(k+j|k), P(k+j|k))`, `j = 1..=steps`, from the
@@ -124,13 +148,12 @@ impl<Tr, Ob> Kf<Tr, Ob> {
         Ob: LinearObservationModel<T, D, M>,
         DefaultAllocator: FilterAllocator<D, M>,
     {
-        scan(0..steps, |prev: Option<&Gaussian<T, D>>, j| {
-            let current = prev.unwrap_or(prediction);
-            if j == 0 || mode == MultiStep::ReuseLastObservation {
-                self.predictor_step(current, Some(last_observation))
-            } else {
-                self.predict(current)
+        scan(0..steps, |prev: Option<&Gaussian<T, D>>, _| match prev {
+            None => self.predictor_step(prediction, Some(last_observation)),
+            Some(current) if mode == MultiStep::ReuseLastObservation => {
+                self.predictor_step_checked(current, Some(last_observation), InputChecks::Cheap)
             }
+            Some(current) => self.predict_own_output(current),
         })
     }
 }

@@ -5,7 +5,7 @@
 //! ([`trajpred_kalman::driver`]); forecasts at any future times.
 
 use super::{invalid, positions_forecast};
-use nalgebra::{DMatrix, DVector, Dyn};
+use nalgebra::{Const, DefaultAllocator, Dim, Dyn, OMatrix, OVector, U1, U2, U3, U4, U6, U9};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use trajpred_core::{
@@ -15,7 +15,7 @@ use trajpred_kalman::driver::{TimeStepFilter, Timed, drive};
 use trajpred_kalman::motion::{
     KinematicLayout, StateOrder, damped_velocity, kinematic_continuous, position_observation,
 };
-use trajpred_kalman::{KalmanError, Kf, LinearObservation, LinearTransition};
+use trajpred_kalman::{FilterAllocator, KalmanError, Kf, LinearObservation, LinearTransition};
 
 /// Settings of [`KfTime`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -111,7 +111,24 @@ pub struct KfTime {
     params: KfTimeParams,
 }
 
-type DynKf = Kf<LinearTransition<f64, Dyn>, LinearObservation<f64, Dyn, Dyn>>;
+type SizedKf<N, M> = Kf<LinearTransition<f64, N>, LinearObservation<f64, N, M>>;
+
+/// Calls `$self.$method::<N, M>($args)` at the static state and observation sizes of a
+/// 1-3 axis constant-velocity or constant-acceleration state (dynamic sizes otherwise), so
+/// the filter's matrices live on the stack.
+macro_rules! sized {
+    ($self:ident, $axes:expr, $method:ident($($arg:expr),*)) => {
+        match ($axes, $self.params.derivatives) {
+            (1, 2) => $self.$method::<U2, U1>($($arg),*),
+            (2, 2) => $self.$method::<U4, U2>($($arg),*),
+            (3, 2) => $self.$method::<U6, U3>($($arg),*),
+            (1, 3) => $self.$method::<U3, U1>($($arg),*),
+            (2, 3) => $self.$method::<U6, U2>($($arg),*),
+            (3, 3) => $self.$method::<U9, U3>($($arg),*),
+            _ => $self.$method::<Dyn, Dyn>($($arg),*),
+        }
+    };
+}
 
 fn kalman(e: KalmanError) -> Error {
     Error::method("kf-time", e)
@@ -134,50 +151,88 @@ impl KfTime {
             .map_err(kalman)
     }
 
-    /// The filter after running through `history` with noise `(q, r)`.
+    /// The filter after running through `history` with noise `(q, r)`, at state size `N`
+    /// and observation size `M` (static for 1-3 axes, see [`sized`]).
     #[allow(clippy::type_complexity)]
-    fn run(
+    fn run<N: Dim, M: Dim>(
         &self,
         history: &Trajectory,
         q: f64,
         r: f64,
-    ) -> Result<Timed<f64, Dyn, DynKf, impl Fn(f64) -> trajpred_kalman::Result<DynKf>>> {
+    ) -> Result<Timed<f64, N, SizedKf<N, M>, impl Fn(f64) -> trajpred_kalman::Result<SizedKf<N, M>>>>
+    where
+        DefaultAllocator: FilterAllocator<N, M>,
+    {
         let d = history.dim();
         let layout = self.layout(d)?;
-        let n = layout.state_dim();
+        let (nd, md) = (N::from_usize(layout.state_dim()), M::from_usize(d));
         let tau = self.params.time_constant;
         let make = move |dt: f64| {
             let tr = match tau {
-                Some(tau) => damped_velocity::<f64, Dyn>(layout, dt, q, tau)?,
-                None => kinematic_continuous::<f64, Dyn>(layout, dt, q)?,
+                Some(tau) => damped_velocity::<f64, N>(layout, dt, q, tau)?,
+                None => kinematic_continuous::<f64, N>(layout, dt, q)?,
             };
-            let obs = position_observation::<f64, Dyn, Dyn>(layout, r)?;
+            let obs = position_observation::<f64, N, M>(layout, r)?;
             Kf::new(tr, obs)
         };
         let first = history.point(0);
-        let mut mean = DVector::zeros(n);
-        let mut var = DVector::from_element(n, self.params.initial_rate_variance);
+        let mut mean = OVector::<f64, N>::zeros_generic(nd, Const::<1>);
+        let mut var = OVector::<f64, N>::from_element_generic(
+            nd,
+            Const::<1>,
+            self.params.initial_rate_variance,
+        );
         for a in 0..d {
             mean[a] = first[a];
             var[a] = r;
         }
-        let start = Gaussian::new(mean, DMatrix::from_diagonal(&var))?;
+        let start = Gaussian::new(mean, OMatrix::<f64, N, N>::from_diagonal(&var))?;
         let mut f = Timed::new(make, start);
-        let z: Vec<Option<DVector<f64>>> = (0..history.len())
-            .map(|k| Some(DVector::from_column_slice(&history.point(k))))
+        let z: Vec<Option<OVector<f64, M>>> = (0..history.len())
+            .map(|k| {
+                let p = history.point(k);
+                Some(OVector::<f64, M>::from_fn_generic(
+                    md,
+                    Const::<1>,
+                    |a, _| p[a],
+                ))
+            })
             .collect();
         drive(&mut f, history.times(), &z, |_, _| Ok(())).map_err(kalman)?;
         Ok(f)
+    }
+
+    /// The log-likelihood of one track under `(q, r)` (`-inf` when the filter fails).
+    fn track_log_likelihood<N: Dim, M: Dim>(&self, track: &Trajectory, q: f64, r: f64) -> f64
+    where
+        DefaultAllocator: FilterAllocator<N, M>,
+    {
+        match self.run::<N, M>(track, q, r) {
+            Ok(f) => f.log_likelihood(),
+            Err(_) => f64::NEG_INFINITY,
+        }
+    }
+
+    /// The forecasts `offsets` seconds after the end of `history`.
+    fn forecast_sized<N: Dim, M: Dim>(
+        &self,
+        history: &Trajectory,
+        offsets: &[f64],
+    ) -> Result<Forecast>
+    where
+        DefaultAllocator: FilterAllocator<N, M>,
+    {
+        let (q, r) = (self.params.spectral_density, self.params.r);
+        let f = self.run::<N, M>(history, q, r)?;
+        let states = f.forecast_at(offsets).map_err(kalman)?;
+        positions_forecast(&states, history.dim())
     }
 
     /// The log-likelihood of the tracks under `(q, r)`, summed.
     fn log_likelihood(&self, tracks: &[Trajectory], q: f64, r: f64) -> f64 {
         tracks
             .par_iter()
-            .map(|t| match self.run(t, q, r) {
-                Ok(f) => f.log_likelihood(),
-                Err(_) => f64::NEG_INFINITY,
-            })
+            .map(|t| sized!(self, t.dim(), track_log_likelihood(t, q, r)))
             .sum()
     }
 }
@@ -267,8 +322,6 @@ impl Predictor for KfTime {
         check_forecast_args(history, times.len(), 1)?;
         let last = history.times()[history.len() - 1];
         let offsets: Vec<f64> = times.iter().map(|&t| t - last).collect();
-        let f = self.run(history, self.params.spectral_density, self.params.r)?;
-        let states = f.forecast_at(&offsets).map_err(kalman)?;
-        positions_forecast(&states, history.dim())
+        sized!(self, history.dim(), forecast_sized(history, &offsets))
     }
 }
