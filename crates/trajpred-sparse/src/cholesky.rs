@@ -4,6 +4,8 @@
 //! Rows are stored separately (row `i` holds `L[i][0..=i]`), so both triangular solves
 //! run over contiguous memory and the factor grows without a capacity guess.
 
+use crate::kernels;
+
 /// Lower-triangular Cholesky factor of the Gram matrix of the active set.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct CholeskyFactor {
@@ -65,22 +67,12 @@ impl CholeskyFactor {
 
     /// Solves `L z = b` in place.
     pub(crate) fn forward_in_place(&self, b: &mut [f64]) {
-        for (i, row) in self.rows.iter().enumerate() {
-            let s: f64 = dot(&row[..i], &b[..i]);
-            b[i] = (b[i] - s) / row[i];
-        }
+        kernels::forward(&self.rows, b);
     }
 
     /// Solves `L^T x = z` in place.
     pub(crate) fn backward_in_place(&self, z: &mut [f64]) {
-        for i in (0..self.rows.len()).rev() {
-            let row = &self.rows[i];
-            let xi = z[i] / row[i];
-            z[i] = xi;
-            for (zj, lij) in z[..i].iter_mut().zip(&row[..i]) {
-                *zj -= lij * xi;
-            }
-        }
+        kernels::backward(&self.rows, z);
     }
 
     /// Solves `G x = b` in place.
@@ -88,26 +80,6 @@ impl CholeskyFactor {
         self.forward_in_place(b);
         self.backward_in_place(b);
     }
-}
-
-/// Dot product with four independent accumulators (lets the compiler vectorise).
-pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let mut acc = [0.0f64; 4];
-    let chunks = n / 4;
-    for k in 0..chunks {
-        let i = 4 * k;
-        acc[0] += a[i] * b[i];
-        acc[1] += a[i + 1] * b[i + 1];
-        acc[2] += a[i + 2] * b[i + 2];
-        acc[3] += a[i + 3] * b[i + 3];
-    }
-    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-    for i in 4 * chunks..n {
-        s += a[i] * b[i];
-    }
-    s
 }
 
 #[cfg(test)]

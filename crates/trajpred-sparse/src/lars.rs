@@ -2,8 +2,9 @@
 //! Johnstone, Tibshirani 2004), with a validating builder ([`LarsParams`]) and the whole
 //! fitted path ([`Lars`]).
 
-use crate::cholesky::{Append, CholeskyFactor, dot};
+use crate::cholesky::{Append, CholeskyFactor};
 use crate::error::{Error, Result};
+use crate::kernels::{self, dot};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
@@ -263,7 +264,7 @@ impl LarsParams {
         let mut raw_norms = Vec::with_capacity(p);
         for j in 0..p {
             let col = x.column(j);
-            let sq = crate::cholesky::dot(col.as_slice(), col.as_slice());
+            let sq = dot(col.as_slice(), col.as_slice());
             if !sq.is_finite() {
                 if let Some(row) = col.iter().position(|v| !v.is_finite()) {
                     return Err(Error::NonFinite {
@@ -343,7 +344,7 @@ impl LarsParams {
         }
         let ys: Vec<f64> = y.iter().map(|v| v - y_mean).collect();
         // every correlation is bounded by |x_j| |y|: a finite squared norm keeps them finite
-        if !crate::cholesky::dot(&ys, &ys).is_finite() {
+        if !dot(&ys, &ys).is_finite() {
             return Err(Error::NonFinite {
                 what: "centred target's squared norm (it overflows f64: rescale y)",
                 row: first_overflow(ys.iter().map(|v| v * v)),
@@ -360,7 +361,7 @@ impl LarsParams {
         for e in &excluded {
             eligible[e.feature] = false;
         }
-        let core = Core::new(xs, use_gram);
+        let mut core = Core::new(xs, use_gram);
         let mut path = core.run(self, &ys, eligible, &mut excluded);
         if matches!(
             path.stop,
@@ -373,16 +374,33 @@ impl LarsParams {
 
         // --- back to the original scale ---------------------------------------------------
         let knots = path.alphas.len();
-        let std_path = DMatrix::from_fn(knots, p, |k, j| path.coefs[k][j]);
-        let coef_path = DMatrix::from_fn(knots, p, |k, j| path.coefs[k][j] / x_scale[j]);
-        let intercepts: Vec<f64> = (0..knots)
-            .map(|k| y_mean - (0..p).map(|j| coef_path[(k, j)] * x_mean[j]).sum::<f64>())
-            .collect();
+        // row-major knots x p (one knot after another): transposed into the column-major
+        // matrices once, and checked with one linear scan each
+        let flat: Vec<f64> = path.coefs.concat();
+        let std_path = DMatrix::from_row_slice(knots, p, &flat);
+        let coef_path = if x_scale.iter().all(|&s| s == 1.0) {
+            std_path.clone()
+        } else {
+            let mut m = std_path.clone();
+            for (j, s) in x_scale.iter().enumerate() {
+                m.column_mut(j).iter_mut().for_each(|v| *v /= s);
+            }
+            m
+        };
+        let mut intercepts = vec![y_mean; knots];
+        for (j, &m) in x_mean.iter().enumerate() {
+            if m != 0.0 {
+                for (b0, bj) in intercepts.iter_mut().zip(coef_path.column(j).iter()) {
+                    *b0 -= bj * m;
+                }
+            }
+        }
         // whatever overflowed inside the path shows in its output: an error, never inf or NaN
         let bad_coef = |m: &DMatrix<f64>| {
-            (0..knots)
-                .flat_map(|k| (0..p).map(move |j| (k, j)))
-                .find(|&(k, j)| !m[(k, j)].is_finite())
+            m.as_slice()
+                .iter()
+                .position(|v| !v.is_finite())
+                .map(|i| (i % knots, i / knots))
         };
         if let Some(k) = path.alphas.iter().position(|a| !a.is_finite()) {
             return Err(Error::NonFinite {
@@ -618,48 +636,33 @@ struct Path {
     chol: CholeskyFactor,
 }
 
-/// `X^T X` through nalgebra's blocked gemm (matrixmultiply; `tr_mul` computes one dot product
-/// per entry and is ~15x slower on 5000 x 500), by column blocks so that only the upper block
-/// triangle is multiplied (about 56% of the full product's flops with 8 blocks, used from p = 256 on; smaller
-/// blocks run below gemm's efficient size), then mirrored.
-fn gram_matrix(xs: &DMatrix<f64>) -> DMatrix<f64> {
-    let p = xs.ncols();
-    let blocks = if p >= 256 { 8 } else { 1 };
-    let width = p.div_ceil(blocks);
-    let mut g = DMatrix::zeros(p, p);
-    let mut j0 = 0;
-    while j0 < p {
-        let w = width.min(p - j0);
-        let block_t = xs.columns(j0, w).transpose();
-        let upper = &block_t * xs.columns(j0, p - j0);
-        g.view_mut((j0, j0), (w, p - j0)).copy_from(&upper);
-        j0 += w;
-    }
-    for j in 0..p {
-        for i in (j + 1)..p {
-            g[(i, j)] = g[(j, i)];
-        }
-    }
-    g
-}
-
 struct Core<'a> {
     xs: &'a DMatrix<f64>,
     n: usize,
     p: usize,
-    /// `X^T X`, when precomputed.
-    gram: Option<DMatrix<f64>>,
+    /// `X^T X` (column-major p x p), when precomputed.
+    gram: Option<Vec<f64>>,
     /// `||x_j||^2`.
     sq_norms: Vec<f64>,
+    /// Scratch without the Gram matrix: the equiangular vector `u = X_A w` (length n), the
+    /// eligible inactive columns and their `a_j`.
+    u: Vec<f64>,
+    inactive: Vec<usize>,
+    a_inactive: Vec<f64>,
 }
 
 impl<'a> Core<'a> {
     fn new(xs: &'a DMatrix<f64>, use_gram: bool) -> Self {
         let (n, p) = xs.shape();
-        let gram = use_gram.then(|| gram_matrix(xs));
+        let gram = use_gram.then(|| kernels::gram(xs.as_slice(), n, p));
         let sq_norms = match &gram {
-            Some(g) => (0..p).map(|j| g[(j, j)]).collect(),
-            None => (0..p).map(|j| xs.column(j).norm_squared()).collect(),
+            Some(g) => (0..p).map(|j| g[j * p + j]).collect(),
+            None => (0..p)
+                .map(|j| {
+                    let c = &xs.as_slice()[j * n..(j + 1) * n];
+                    dot(c, c)
+                })
+                .collect(),
         };
         Core {
             xs,
@@ -667,6 +670,9 @@ impl<'a> Core<'a> {
             p,
             gram,
             sq_norms,
+            u: vec![0.0; if use_gram { 0 } else { n }],
+            inactive: Vec::with_capacity(p),
+            a_inactive: Vec::with_capacity(p),
         }
     }
 
@@ -678,35 +684,41 @@ impl<'a> Core<'a> {
     fn gram_with_active(&self, active: &[usize], j: usize, out: &mut Vec<f64>) {
         out.clear();
         match &self.gram {
-            Some(g) => out.extend(active.iter().map(|&a| g[(a, j)])),
+            Some(g) => out.extend(active.iter().map(|&a| g[j * self.p + a])),
             None => {
-                let xj = self.col(j);
-                out.extend(active.iter().map(|&a| dot(self.col(a), xj)));
+                out.resize(active.len(), 0.0);
+                kernels::dots(self.xs.as_slice(), self.n, active, self.col(j), out);
             }
         }
     }
 
-    /// `a = X^T X_A w` for every column.
-    fn equiangular_correlations(&self, active: &[usize], w: &[f64], a: &mut [f64]) {
-        a.iter_mut().for_each(|v| *v = 0.0);
+    /// `a = X^T X_A w`: for every column with the Gram matrix; without it, for the eligible
+    /// inactive columns from `u = X_A w`, and `a_j = aa s_j` (eq. 2.6) on the active set.
+    #[allow(clippy::too_many_arguments)]
+    fn equiangular_correlations(
+        &mut self,
+        active: &[usize],
+        w: &[f64],
+        signs: &[f64],
+        aa: f64,
+        usable: impl Fn(usize) -> bool,
+        a: &mut [f64],
+    ) {
         match &self.gram {
-            Some(g) => {
-                for (&k, &wk) in active.iter().zip(w) {
-                    let gk = &g.as_slice()[k * self.p..(k + 1) * self.p];
-                    for (ai, gi) in a.iter_mut().zip(gk) {
-                        *ai += wk * gi;
-                    }
-                }
-            }
+            Some(g) => kernels::combine(g, self.p, active, w, a),
             None => {
-                let mut u = vec![0.0; self.n];
-                for (&k, &wk) in active.iter().zip(w) {
-                    for (ui, xi) in u.iter_mut().zip(self.col(k)) {
-                        *ui += wk * xi;
-                    }
+                let data = self.xs.as_slice();
+                kernels::combine(data, self.n, active, w, &mut self.u);
+                self.inactive.clear();
+                self.inactive.extend((0..self.p).filter(|&j| usable(j)));
+                self.a_inactive.resize(self.inactive.len(), 0.0);
+                kernels::dots(data, self.n, &self.inactive, &self.u, &mut self.a_inactive);
+                a.fill(0.0);
+                for (&j, &v) in self.inactive.iter().zip(&self.a_inactive) {
+                    a[j] = v;
                 }
-                for (j, aj) in a.iter_mut().enumerate() {
-                    *aj = dot(self.col(j), &u);
+                for (&j, &s) in active.iter().zip(signs) {
+                    a[j] = aa * s;
                 }
             }
         }
@@ -721,15 +733,14 @@ impl<'a> Core<'a> {
         if active.is_empty() || chol.len() != active.len() {
             return;
         }
+        let data = self.xs.as_slice();
+        let mut fitted = vec![0.0; self.n];
+        let mut delta = vec![0.0; active.len()];
         for _ in 0..2 {
-            let mut r = ys.to_vec();
-            for &k in active {
-                let bk = beta[k];
-                for (ri, xi) in r.iter_mut().zip(self.col(k)) {
-                    *ri -= bk * xi;
-                }
-            }
-            let mut delta: Vec<f64> = active.iter().map(|&k| dot(self.col(k), &r)).collect();
+            let b: Vec<f64> = active.iter().map(|&k| beta[k]).collect();
+            kernels::combine(data, self.n, active, &b, &mut fitted);
+            let r: Vec<f64> = ys.iter().zip(&fitted).map(|(y, f)| y - f).collect();
+            kernels::dots(data, self.n, active, &r, &mut delta);
             chol.solve_in_place(&mut delta);
             if delta.iter().any(|d| !d.is_finite()) {
                 return;
@@ -741,7 +752,7 @@ impl<'a> Core<'a> {
     }
 
     fn run(
-        &self,
+        &mut self,
         params: &LarsParams,
         ys: &[f64],
         mut eligible: Vec<bool>,
@@ -749,15 +760,15 @@ impl<'a> Core<'a> {
     ) -> Path {
         let p = self.p;
         let nf = self.n as f64;
-        let mut c: Vec<f64> = (0..p)
-            .map(|j| {
-                if eligible[j] {
-                    dot(self.col(j), ys)
-                } else {
-                    0.0
-                }
-            })
-            .collect();
+        let mut c = vec![0.0; p];
+        {
+            let cols: Vec<usize> = (0..p).filter(|&j| eligible[j]).collect();
+            let mut cc = vec![0.0; cols.len()];
+            kernels::dots(self.xs.as_slice(), self.n, &cols, ys, &mut cc);
+            for (&j, v) in cols.iter().zip(cc) {
+                c[j] = v;
+            }
+        }
         let c0 = (0..p)
             .filter(|&j| eligible[j])
             .map(|j| c[j].abs())
@@ -876,7 +887,14 @@ impl<'a> Core<'a> {
             }
             let aa = 1.0 / q.sqrt();
             w.iter_mut().for_each(|v| *v *= aa);
-            self.equiangular_correlations(&active, &w, &mut a);
+            self.equiangular_correlations(
+                &active,
+                &w,
+                &signs,
+                aa,
+                |j| eligible[j] && !is_active[j],
+                &mut a,
+            );
 
             // --- step length --------------------------------------------------------------
             let gamma_hat = big_c / aa;

@@ -75,6 +75,7 @@
 mod cholesky;
 pub mod error;
 pub mod gsc;
+mod kernels;
 pub mod lars;
 
 pub use error::{Error, Result};
