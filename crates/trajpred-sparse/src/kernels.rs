@@ -22,12 +22,6 @@ fn arch() -> Arch {
     Arch::new()
 }
 
-/// Column `j` of the column-major matrix `data` with `n` rows.
-#[inline(always)]
-fn col(data: &[f64], n: usize, j: usize) -> &[f64] {
-    &data[j * n..(j + 1) * n]
-}
-
 // ---------------------------------------------------------------------------------------
 // dot
 
@@ -38,6 +32,48 @@ fn col(data: &[f64], n: usize, j: usize) -> &[f64] {
 fn dot_with<S: Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
     let n = a.len().min(b.len());
     dots_with::<S, 1>(simd, [&a[..n]], &b[..n])[0]
+}
+
+/// `a . b` with four chains (the latency-bound rows of a triangular solve); its own
+/// summation order, used by both [`forward`] and [`dot4`].
+#[inline(always)]
+fn dot4_with<S: Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (ah, at) = S::as_simd_f64s(&a[..n]);
+    let (bh, bt) = S::as_simd_f64s(&b[..n]);
+    let z = simd.splat_f64s(0.0);
+    let mut acc = [z; 4];
+    let mut ac = ah.chunks_exact(4);
+    let mut bc = bh.chunks_exact(4);
+    for (x, y) in (&mut ac).zip(&mut bc) {
+        for u in 0..4 {
+            acc[u] = simd.mul_add_e_f64s(x[u], y[u], acc[u]);
+        }
+    }
+    for (x, y) in ac.remainder().iter().zip(bc.remainder()) {
+        acc[0] = simd.mul_add_e_f64s(*x, *y, acc[0]);
+    }
+    let s = simd.add_f64s(simd.add_f64s(acc[0], acc[1]), simd.add_f64s(acc[2], acc[3]));
+    let mut r = simd.reduce_sum_f64s(s);
+    for (x, y) in at.iter().zip(bt) {
+        r += x * y;
+    }
+    r
+}
+
+struct Dot4<'a>(&'a [f64], &'a [f64]);
+
+impl WithSimd for Dot4<'_> {
+    type Output = f64;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> f64 {
+        dot4_with(simd, self.0, self.1)
+    }
+}
+
+/// `a . b` in the order of the triangular solves (see [`dot4_with`]).
+pub(crate) fn dot4(a: &[f64], b: &[f64]) -> f64 {
+    arch().dispatch(Dot4(a, b))
 }
 
 struct Dot<'a>(&'a [f64], &'a [f64]);
@@ -96,6 +132,28 @@ fn dots_with<S: Simd, const K: usize>(simd: S, c: [&[f64]; K], v: &[f64]) -> [f6
     out
 }
 
+/// `out[k] = x_{cols[k]}[rows] . v` (`v.len()` = the number of rows).
+#[inline(always)]
+fn dots_into<S: Simd>(
+    simd: S,
+    (data, n): (&[f64], usize),
+    cols: &[usize],
+    (r0, r1): (usize, usize),
+    v: &[f64],
+    out: &mut [f64],
+) {
+    let sub = |j: usize| &data[j * n + r0..j * n + r1];
+    let mut groups = cols.chunks_exact(GROUP);
+    let mut outs = out.chunks_exact_mut(GROUP);
+    for (g, o) in (&mut groups).zip(&mut outs) {
+        let c: [&[f64]; GROUP] = [sub(g[0]), sub(g[1]), sub(g[2]), sub(g[3])];
+        o.copy_from_slice(&dots_with(simd, c, v));
+    }
+    for (&j, o) in groups.remainder().iter().zip(outs.into_remainder()) {
+        *o = dot_with(simd, sub(j), v);
+    }
+}
+
 struct Dots<'a> {
     data: &'a [f64],
     n: usize,
@@ -115,15 +173,7 @@ impl WithSimd for Dots<'_> {
             v,
             out,
         } = self;
-        let mut groups = cols.chunks_exact(GROUP);
-        let mut outs = out.chunks_exact_mut(GROUP);
-        for (g, o) in (&mut groups).zip(&mut outs) {
-            let c: [&[f64]; GROUP] = std::array::from_fn(|k| col(data, n, g[k]));
-            o.copy_from_slice(&dots_with(simd, c, v));
-        }
-        for (&j, o) in groups.remainder().iter().zip(outs.into_remainder()) {
-            *o = dot_with(simd, col(data, n, j), v);
-        }
+        dots_into(simd, (data, n), cols, (0, n), v, out);
     }
 }
 
@@ -152,6 +202,47 @@ struct Combine<'a> {
     out: &'a mut [f64],
 }
 
+/// `out = sum_k w[k] x_{cols[k]}[rows]` (`out.len()` = the number of rows).
+#[inline(always)]
+fn combine_into<S: Simd>(
+    simd: S,
+    (data, n): (&[f64], usize),
+    cols: &[usize],
+    (r0, r1): (usize, usize),
+    w: &[f64],
+    out: &mut [f64],
+) {
+    let sub = |j: usize| &data[j * n + r0..j * n + r1];
+    out.fill(0.0);
+    let mut k = 0;
+    while k < cols.len() {
+        let m = GROUP.min(cols.len() - k);
+        // a short group repeats its first column with weight 0
+        let c: [&[f64]; GROUP] = std::array::from_fn(|i| sub(cols[k + if i < m { i } else { 0 }]));
+        let wk: [f64; GROUP] = std::array::from_fn(|i| if i < m { w[k + i] } else { 0.0 });
+        let mut ws = [simd.splat_f64s(0.0); GROUP];
+        for i in 0..GROUP {
+            ws[i] = simd.splat_f64s(wk[i]);
+        }
+        let heads: [&[S::f64s]; GROUP] = std::array::from_fn(|i| S::as_simd_f64s(c[i]).0);
+        let (oh, ot) = S::as_mut_simd_f64s(&mut *out);
+        let done = oh.len() * S::F64_LANES;
+        for (r, o) in oh.iter_mut().enumerate() {
+            let mut acc = *o;
+            for i in 0..GROUP {
+                acc = simd.mul_add_e_f64s(ws[i], heads[i][r], acc);
+            }
+            *o = acc;
+        }
+        for (r, o) in ot.iter_mut().enumerate() {
+            for i in 0..GROUP {
+                *o += wk[i] * c[i][done + r];
+            }
+        }
+        k += m;
+    }
+}
+
 impl WithSimd for Combine<'_> {
     type Output = ();
     #[inline(always)]
@@ -163,36 +254,79 @@ impl WithSimd for Combine<'_> {
             w,
             out,
         } = self;
+        combine_into(simd, (data, n), cols, (0, n), w, out);
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// X_S^T (y - X_S b) in one pass over X_S
+
+/// Rows per block of [`residual_dots`]: a block of up to 500 columns stays in L2 between
+/// its two uses.
+const RESIDUAL_ROWS: usize = 512;
+
+struct ResidualDots<'a> {
+    data: &'a [f64],
+    n: usize,
+    cols: &'a [usize],
+    b: &'a [f64],
+    y: &'a [f64],
+    out: &'a mut [f64],
+}
+
+impl WithSimd for ResidualDots<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let ResidualDots {
+            data,
+            n,
+            cols,
+            b,
+            y,
+            out,
+        } = self;
         out.fill(0.0);
-        let mut k = 0;
-        while k < cols.len() {
-            let m = GROUP.min(cols.len() - k);
-            // a short group repeats its first column with weight 0
-            let c: [&[f64]; GROUP] =
-                std::array::from_fn(|i| col(data, n, cols[k + if i < m { i } else { 0 }]));
-            let wk: [f64; GROUP] = std::array::from_fn(|i| if i < m { w[k + i] } else { 0.0 });
-            let mut ws = [simd.splat_f64s(0.0); GROUP];
-            for i in 0..GROUP {
-                ws[i] = simd.splat_f64s(wk[i]);
+        let mut r = vec![0.0; RESIDUAL_ROWS.min(n)];
+        let mut part = vec![0.0; cols.len()];
+        let mut r0 = 0;
+        while r0 < n {
+            let r1 = (r0 + RESIDUAL_ROWS).min(n);
+            let rb = &mut r[..r1 - r0];
+            combine_into(simd, (data, n), cols, (r0, r1), b, rb);
+            for (ri, yi) in rb.iter_mut().zip(&y[r0..r1]) {
+                *ri = yi - *ri;
             }
-            let heads: [&[S::f64s]; GROUP] = std::array::from_fn(|i| S::as_simd_f64s(c[i]).0);
-            let (oh, ot) = S::as_mut_simd_f64s(&mut *out);
-            let done = oh.len() * S::F64_LANES;
-            for (r, o) in oh.iter_mut().enumerate() {
-                let mut acc = *o;
-                for i in 0..GROUP {
-                    acc = simd.mul_add_e_f64s(ws[i], heads[i][r], acc);
-                }
-                *o = acc;
+            dots_into(simd, (data, n), cols, (r0, r1), rb, &mut part);
+            for (o, q) in out.iter_mut().zip(&part) {
+                *o += q;
             }
-            for (r, o) in ot.iter_mut().enumerate() {
-                for i in 0..GROUP {
-                    *o += wk[i] * c[i][done + r];
-                }
-            }
-            k += m;
+            r0 = r1;
         }
     }
+}
+
+/// `out = X_S^T (y - X_S b)` for the columns `S = cols` of the column-major `data` (`n`
+/// rows), by blocks of rows, so that `X_S` is read from memory once.
+pub(crate) fn residual_dots(
+    data: &[f64],
+    n: usize,
+    cols: &[usize],
+    b: &[f64],
+    y: &[f64],
+    out: &mut [f64],
+) {
+    debug_assert_eq!(y.len(), n);
+    debug_assert_eq!(b.len(), cols.len());
+    debug_assert_eq!(out.len(), cols.len());
+    arch().dispatch(ResidualDots {
+        data,
+        n,
+        cols,
+        b,
+        y,
+        out,
+    });
 }
 
 /// `out = sum_k w[k] x_{cols[k]}` for the columns of the column-major `data` (`n` rows);
@@ -223,7 +357,7 @@ impl WithSimd for Forward<'_> {
     fn with_simd<S: Simd>(self, simd: S) {
         let Forward { rows, b } = self;
         for (i, row) in rows.iter().enumerate() {
-            let s = dot_with(simd, &row[..i], &b[..i]);
+            let s = dot4_with(simd, &row[..i], &b[..i]);
             b[i] = (b[i] - s) / row[i];
         }
     }
@@ -492,6 +626,26 @@ mod tests {
             for i in 0..n {
                 let want: f64 = cols.iter().zip(&w).map(|(&j, wk)| wk * x[j * n + i]).sum();
                 assert!(close(u[i], want), "combine {n}x{p} row {i}");
+            }
+            let b: Vec<f64> = (0..p).map(|k| 0.25 * k as f64 - 0.5).collect();
+            let mut rd = vec![f64::NAN; p];
+            residual_dots(&x, n, &cols, &b, &v, &mut rd);
+            let resid: Vec<f64> = (0..n)
+                .map(|i| {
+                    v[i] - cols
+                        .iter()
+                        .zip(&b)
+                        .map(|(&j, bk)| bk * x[j * n + i])
+                        .sum::<f64>()
+                })
+                .collect();
+            for (k, &j) in cols.iter().enumerate() {
+                let want = naive_dot(&x[j * n..(j + 1) * n], &resid);
+                assert!(
+                    (rd[k] - want).abs() <= 1e-10 * (1.0 + want.abs()),
+                    "residual_dots {n}x{p} col {j}: {} vs {want}",
+                    rd[k]
+                );
             }
             let g = gram(&x, n, p);
             for i in 0..p {

@@ -366,7 +366,7 @@ impl LarsParams {
         if matches!(
             path.stop,
             StopReason::Complete | StopReason::CorrelationVanished
-        ) && let Some(last) = path.coefs.last_mut()
+        ) && let Some(last) = path.coefs.rchunks_exact_mut(p).next()
         {
             core.refine(&path.active, &path.chol, &ys, last);
         }
@@ -376,8 +376,7 @@ impl LarsParams {
         let knots = path.alphas.len();
         // row-major knots x p (one knot after another): transposed into the column-major
         // matrices once, and checked with one linear scan each
-        let flat: Vec<f64> = path.coefs.concat();
-        let std_path = DMatrix::from_row_slice(knots, p, &flat);
+        let std_path = DMatrix::from_row_slice(knots, p, &path.coefs);
         let coef_path = if x_scale.iter().all(|&s| s == 1.0) {
             std_path.clone()
         } else {
@@ -629,7 +628,8 @@ impl Lars {
 
 struct Path {
     alphas: Vec<f64>,
-    coefs: Vec<Vec<f64>>,
+    /// knot after knot, `p` coefficients each
+    coefs: Vec<f64>,
     events: Vec<PathEvent>,
     active: Vec<usize>,
     stop: StopReason,
@@ -649,6 +649,11 @@ struct Core<'a> {
     u: Vec<f64>,
     inactive: Vec<usize>,
     a_inactive: Vec<f64>,
+    /// With the Gram matrix: `G[gc_rows, :]` (column-major), a superset of the inactive
+    /// columns' rows, and which columns it has rows for.
+    gc: Vec<f64>,
+    gc_rows: Vec<usize>,
+    in_gc: Vec<bool>,
 }
 
 impl<'a> Core<'a> {
@@ -673,6 +678,9 @@ impl<'a> Core<'a> {
             u: vec![0.0; if use_gram { 0 } else { n }],
             inactive: Vec::with_capacity(p),
             a_inactive: Vec::with_capacity(p),
+            gc: Vec::new(),
+            gc_rows: Vec::new(),
+            in_gc: vec![false; p],
         }
     }
 
@@ -692,8 +700,8 @@ impl<'a> Core<'a> {
         }
     }
 
-    /// `a = X^T X_A w`: for every column with the Gram matrix; without it, for the eligible
-    /// inactive columns from `u = X_A w`, and `a_j = aa s_j` (eq. 2.6) on the active set.
+    /// `a = X^T X_A w` for the eligible inactive columns (from the Gram matrix's rows of
+    /// those columns, or from `u = X_A w`), and `a_j = aa s_j` (eq. 2.6) on the active set.
     #[allow(clippy::too_many_arguments)]
     fn equiangular_correlations(
         &mut self,
@@ -704,23 +712,54 @@ impl<'a> Core<'a> {
         usable: impl Fn(usize) -> bool,
         a: &mut [f64],
     ) {
+        self.inactive.clear();
+        self.inactive.extend((0..self.p).filter(|&j| usable(j)));
         match &self.gram {
-            Some(g) => kernels::combine(g, self.p, active, w, a),
+            Some(g) => {
+                // rows of G for the inactive columns only (sklearn keeps them apart by
+                // swapping rows of G): a compacted copy, rebuilt when a quarter of its rows
+                // has become active or a dropped column needs a row it lacks
+                let p = self.p;
+                let stale = self.inactive.len() * 4 < self.gc_rows.len() * 3
+                    || self.inactive.iter().any(|&j| !self.in_gc[j]);
+                if stale {
+                    self.gc_rows.clone_from(&self.inactive);
+                    self.in_gc.iter_mut().for_each(|v| *v = false);
+                    for &j in &self.gc_rows {
+                        self.in_gc[j] = true;
+                    }
+                    let m = self.gc_rows.len();
+                    self.gc.resize(m * p, 0.0);
+                    for (k, gk) in self.gc.chunks_exact_mut(m.max(1)).enumerate().take(p) {
+                        let src = &g[k * p..(k + 1) * p];
+                        for (dst, &j) in gk.iter_mut().zip(&self.gc_rows) {
+                            *dst = src[j];
+                        }
+                    }
+                }
+                let m = self.gc_rows.len();
+                self.a_inactive.resize(m, 0.0);
+                if m > 0 {
+                    kernels::combine(&self.gc, m, active, w, &mut self.a_inactive);
+                }
+                a.fill(0.0);
+                for (&j, &v) in self.gc_rows.iter().zip(&self.a_inactive) {
+                    a[j] = v;
+                }
+            }
             None => {
                 let data = self.xs.as_slice();
                 kernels::combine(data, self.n, active, w, &mut self.u);
-                self.inactive.clear();
-                self.inactive.extend((0..self.p).filter(|&j| usable(j)));
                 self.a_inactive.resize(self.inactive.len(), 0.0);
                 kernels::dots(data, self.n, &self.inactive, &self.u, &mut self.a_inactive);
                 a.fill(0.0);
                 for (&j, &v) in self.inactive.iter().zip(&self.a_inactive) {
                     a[j] = v;
                 }
-                for (&j, &s) in active.iter().zip(signs) {
-                    a[j] = aa * s;
-                }
             }
+        }
+        for (&j, &s) in active.iter().zip(signs) {
+            a[j] = aa * s;
         }
     }
 
@@ -734,13 +773,13 @@ impl<'a> Core<'a> {
             return;
         }
         let data = self.xs.as_slice();
-        let mut fitted = vec![0.0; self.n];
         let mut delta = vec![0.0; active.len()];
+        let mut b = vec![0.0; active.len()];
         for _ in 0..2 {
-            let b: Vec<f64> = active.iter().map(|&k| beta[k]).collect();
-            kernels::combine(data, self.n, active, &b, &mut fitted);
-            let r: Vec<f64> = ys.iter().zip(&fitted).map(|(y, f)| y - f).collect();
-            kernels::dots(data, self.n, active, &r, &mut delta);
+            for (bk, &k) in b.iter_mut().zip(active) {
+                *bk = beta[k];
+            }
+            kernels::residual_dots(data, self.n, active, &b, ys, &mut delta);
             chol.solve_in_place(&mut delta);
             if delta.iter().any(|d| !d.is_finite()) {
                 return;
@@ -776,12 +815,15 @@ impl<'a> Core<'a> {
 
         let mut beta = vec![0.0; p];
         let mut alphas = vec![c0 / nf];
-        let mut coefs = vec![beta.clone()];
+        let mut coefs = beta.clone();
         let mut events = Vec::new();
         let mut active: Vec<usize> = Vec::new();
         let mut signs: Vec<f64> = Vec::new();
         let mut is_active = vec![false; p];
         let mut chol = CholeskyFactor::default();
+        // z = L^{-1} s, extended on each entry, recomputed after drops (the downdate changes L)
+        let mut z: Vec<f64> = Vec::new();
+        let mut z_stale = false;
         let mut just_dropped: Vec<usize> = Vec::new();
         let mut big_c = c0;
         let mut step = 0usize;
@@ -840,12 +882,21 @@ impl<'a> Core<'a> {
                 })
                 .collect();
             candidates.sort_by(|&i, &j| c[j].abs().total_cmp(&c[i].abs()).then(i.cmp(&j)));
+            if z_stale {
+                z.clone_from(&signs);
+                chol.forward_in_place(&mut z);
+                z_stale = false;
+            }
             for j in candidates {
                 self.gram_with_active(&active, j, &mut scratch);
                 match chol.append(&scratch, self.sq_norms[j], params.collinearity_tolerance) {
                     Append::Appended => {
                         active.push(j);
-                        signs.push(if c[j] >= 0.0 { 1.0 } else { -1.0 });
+                        let sj = if c[j] >= 0.0 { 1.0 } else { -1.0 };
+                        signs.push(sj);
+                        // the factor grew by one row: z = L^{-1} s grows by one entry, the
+                        // same value a full forward solve would give
+                        chol.forward_extend(&mut z, sj);
                         is_active[j] = true;
                         events.push(PathEvent::Added { feature: j, step });
                     }
@@ -872,8 +923,8 @@ impl<'a> Core<'a> {
             }
 
             // --- equiangular direction: w = AA G_AA^{-1} s ---------------------------------
-            let mut w = signs.clone();
-            chol.solve_in_place(&mut w);
+            let mut w = z.clone();
+            chol.backward_in_place(&mut w);
             let q: f64 = w.iter().zip(&signs).map(|(wi, si)| wi * si).sum();
             if !(q.is_finite() && q > 0.0) {
                 return finish(
@@ -965,6 +1016,7 @@ impl<'a> Core<'a> {
                 let j = active.remove(pos);
                 signs.remove(pos);
                 chol.remove(pos);
+                z_stale = true;
                 is_active[j] = false;
                 beta[j] = 0.0;
                 just_dropped.push(j);
@@ -974,7 +1026,7 @@ impl<'a> Core<'a> {
             let alpha = big_c / nf;
             let prev_alpha = alphas[alphas.len() - 1];
             if params.alpha_min > 0.0 && alpha <= params.alpha_min {
-                let prev = &coefs[coefs.len() - 1];
+                let prev = &coefs[coefs.len() - p..];
                 let ss = if prev_alpha > alpha {
                     (prev_alpha - params.alpha_min) / (prev_alpha - alpha)
                 } else {
@@ -986,11 +1038,11 @@ impl<'a> Core<'a> {
                     .map(|(b0, b1)| b0 + ss * (b1 - b0))
                     .collect();
                 alphas.push(params.alpha_min);
-                coefs.push(knot);
+                coefs.extend_from_slice(&knot);
                 return finish(alphas, coefs, events, active, StopReason::AlphaMin, chol);
             }
             alphas.push(alpha);
-            coefs.push(beta.clone());
+            coefs.extend_from_slice(&beta);
             if full_step {
                 let stop = if any_inactive {
                     StopReason::CorrelationVanished
