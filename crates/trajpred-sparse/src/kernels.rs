@@ -16,6 +16,8 @@ use pulp::{Arch, Simd, WithSimd};
 
 /// Columns per pass in [`dots`] and [`combine`].
 const GROUP: usize = 4;
+/// Columns per pass in [`combine`]: each pass reads and writes `out` once.
+const COMBINE_GROUP: usize = 4;
 
 #[inline]
 fn arch() -> Arch {
@@ -216,26 +218,27 @@ fn combine_into<S: Simd>(
     out.fill(0.0);
     let mut k = 0;
     while k < cols.len() {
-        let m = GROUP.min(cols.len() - k);
+        let m = COMBINE_GROUP.min(cols.len() - k);
         // a short group repeats its first column with weight 0
-        let c: [&[f64]; GROUP] = std::array::from_fn(|i| sub(cols[k + if i < m { i } else { 0 }]));
-        let wk: [f64; GROUP] = std::array::from_fn(|i| if i < m { w[k + i] } else { 0.0 });
-        let mut ws = [simd.splat_f64s(0.0); GROUP];
-        for i in 0..GROUP {
+        let c: [&[f64]; COMBINE_GROUP] =
+            std::array::from_fn(|i| sub(cols[k + if i < m { i } else { 0 }]));
+        let wk: [f64; COMBINE_GROUP] = std::array::from_fn(|i| if i < m { w[k + i] } else { 0.0 });
+        let mut ws = [simd.splat_f64s(0.0); COMBINE_GROUP];
+        for i in 0..COMBINE_GROUP {
             ws[i] = simd.splat_f64s(wk[i]);
         }
-        let heads: [&[S::f64s]; GROUP] = std::array::from_fn(|i| S::as_simd_f64s(c[i]).0);
+        let heads: [&[S::f64s]; COMBINE_GROUP] = std::array::from_fn(|i| S::as_simd_f64s(c[i]).0);
         let (oh, ot) = S::as_mut_simd_f64s(&mut *out);
         let done = oh.len() * S::F64_LANES;
         for (r, o) in oh.iter_mut().enumerate() {
             let mut acc = *o;
-            for i in 0..GROUP {
+            for i in 0..COMBINE_GROUP {
                 acc = simd.mul_add_e_f64s(ws[i], heads[i][r], acc);
             }
             *o = acc;
         }
         for (r, o) in ot.iter_mut().enumerate() {
-            for i in 0..GROUP {
+            for i in 0..COMBINE_GROUP {
                 *o += wk[i] * c[i][done + r];
             }
         }
@@ -418,7 +421,9 @@ struct GramPacked<'a> {
     data: &'a [f64],
     n: usize,
     p: usize,
-    /// `p` rounded up to whole vectors
+    /// a vector packed as feature `p`, so that `X^T extra` comes out as column `p`
+    extra: &'a [f64],
+    /// `p + 1` rounded up to whole vectors
     pl: usize,
     /// column-major `pl x pl`; the upper block triangle is accumulated
     g: &'a mut [f64],
@@ -473,7 +478,16 @@ fn gram_micro<S: Simd, const M: usize, const NR: usize>(
 
 #[inline(always)]
 fn gram_chunks<S: Simd, const NR: usize>(simd: S, job: GramPacked<'_>) {
-    let GramPacked { data, n, p, pl, g } = job;
+    let GramPacked {
+        data,
+        n,
+        p,
+        extra,
+        pl,
+        g,
+    } = job;
+    // the extra vector is packed as feature p
+    let pe = p + 1;
     let l = S::F64_LANES;
     let nblocks = pl / l;
     let block = GRAM_ROWS * l;
@@ -489,6 +503,9 @@ fn gram_chunks<S: Simd, const NR: usize>(simd: S, job: GramPacked<'_>) {
                 let j = fb * l + lane;
                 if j < p {
                     *c = &data[j * n + r0..j * n + r0 + len];
+                    width = lane + 1;
+                } else if j == p {
+                    *c = &extra[r0..r0 + len];
                     width = lane + 1;
                 }
             }
@@ -511,7 +528,7 @@ fn gram_chunks<S: Simd, const NR: usize>(simd: S, job: GramPacked<'_>) {
         while ib < nblocks {
             let m = GRAM_MV.min(nblocks - ib);
             for jb in ib..nblocks {
-                let (blocks, dims) = ((ib, jb), (p, pl));
+                let (blocks, dims) = ((ib, jb), (pe, pl));
                 match m {
                     3 => gram_micro::<S, 3, NR>(simd, &t, len, blocks, g, dims),
                     2 => gram_micro::<S, 2, NR>(simd, &t, len, blocks, g, dims),
@@ -538,18 +555,21 @@ impl WithSimd for GramPacked<'_> {
 }
 
 /// `X^T X` (p x p, column-major, symmetric) of the column-major `data` (`n` rows, `p`
-/// columns): the upper block triangle by a register-blocked kernel over packed chunks of
-/// rows (see [`GRAM_ROWS`]), then mirrored. Every entry is one chain of fused multiply-adds
-/// over the rows in order, whichever block computed it.
-pub(crate) fn gram(data: &[f64], n: usize, p: usize) -> Vec<f64> {
+/// columns), and `X^T extra` (`extra.len() == n`) from the same pass over `X`: the upper block
+/// triangle of `[X extra]^T [X extra]` by a register-blocked kernel over packed chunks of rows
+/// (see [`GRAM_ROWS`]), then mirrored. Every entry is one chain of fused multiply-adds over
+/// the rows in order, whichever block computed it.
+pub(crate) fn gram(data: &[f64], n: usize, p: usize, extra: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    debug_assert_eq!(extra.len(), n);
     let l = lanes();
-    let pl = p.div_ceil(l) * l;
+    let pl = (p + 1).div_ceil(l) * l;
     let mut gp = vec![0.0; pl * pl];
     if n > 0 && p > 0 {
         arch().dispatch(GramPacked {
             data,
             n,
             p,
+            extra,
             pl,
             g: &mut gp,
         });
@@ -562,7 +582,8 @@ pub(crate) fn gram(data: &[f64], n: usize, p: usize) -> Vec<f64> {
             g[i * p + j] = v;
         }
     }
-    g
+    let xty = gp[p * pl..p * pl + p].to_vec();
+    (g, xty)
 }
 
 struct Lanes;
@@ -647,7 +668,11 @@ mod tests {
                     rd[k]
                 );
             }
-            let g = gram(&x, n, p);
+            let (g, xtv) = gram(&x, n, p, &v);
+            for j in 0..p {
+                let want = naive_dot(&x[j * n..(j + 1) * n], &v);
+                assert!(close(xtv[j], want), "gram X^T v {n}x{p} col {j}");
+            }
             for i in 0..p {
                 for j in 0..p {
                     let want = naive_dot(&x[i * n..(i + 1) * n], &x[j * n..(j + 1) * n]);

@@ -17,7 +17,8 @@ pub struct Lars {
     pub(super) n_features: usize,
     pub(super) alphas: Vec<f64>,
     pub(super) std_path: DMatrix<f64>,
-    pub(super) coef_path: DMatrix<f64>,
+    /// `None` when it equals `std_path` (no column scaling)
+    pub(super) coef_path: Option<DMatrix<f64>>,
     pub(super) intercepts: Vec<f64>,
     pub(super) events: Vec<PathEvent>,
     pub(super) active: Vec<usize>,
@@ -57,7 +58,7 @@ impl Lars {
 
     /// Coefficients at every knot on the original scale: row `k` is knot `k`, `knots x p`.
     pub fn coef_path(&self) -> &DMatrix<f64> {
-        &self.coef_path
+        self.coef_path.as_ref().unwrap_or(&self.std_path)
     }
 
     /// Coefficients at every knot in the standardised problem (centred and/or unit-norm
@@ -74,7 +75,7 @@ impl Lars {
     /// Final coefficients (last knot), original scale.
     pub fn coef(&self) -> DVector<f64> {
         let last = self.alphas.len() - 1;
-        self.coef_path.row(last).transpose()
+        self.coef_path().row(last).transpose()
     }
 
     /// Final intercept (last knot).
@@ -144,7 +145,7 @@ impl Lars {
                 col: 0,
             });
         }
-        let b = self.coef_path.row(knot);
+        let b = self.coef_path().row(knot);
         Ok(self.intercepts[knot] + b.iter().zip(row).map(|(b, x)| b * x).sum::<f64>())
     }
 

@@ -372,7 +372,7 @@ impl LarsParams {
         for e in &excluded {
             eligible[e.feature] = false;
         }
-        let mut core = Core::new(xs, use_gram);
+        let mut core = Core::new(xs, &ys, use_gram);
         let mut path = core.run(self, &ys, eligible, &mut excluded);
         if matches!(
             path.stop,
@@ -387,20 +387,22 @@ impl LarsParams {
         let knots = path.alphas.len();
         // row-major knots x p (one knot after another): transposed into the column-major
         // matrices once, and checked with one linear scan each
-        let std_path = DMatrix::from_row_slice(knots, p, &path.coefs);
+        let std_path = knots_by_features(&path.coefs, knots, p);
+        // without scaling the original-scale path is the same matrix: stored once
         let coef_path = if x_scale.iter().all(|&s| s == 1.0) {
-            std_path.clone()
+            None
         } else {
             let mut m = std_path.clone();
             for (j, s) in x_scale.iter().enumerate() {
                 m.column_mut(j).iter_mut().for_each(|v| *v /= s);
             }
-            m
+            Some(m)
         };
         let mut intercepts = vec![y_mean; knots];
+        let orig = coef_path.as_ref().unwrap_or(&std_path);
         for (j, &m) in x_mean.iter().enumerate() {
             if m != 0.0 {
-                for (b0, bj) in intercepts.iter_mut().zip(coef_path.column(j).iter()) {
+                for (b0, bj) in intercepts.iter_mut().zip(orig.column(j).iter()) {
                     *b0 -= bj * m;
                 }
             }
@@ -419,7 +421,7 @@ impl LarsParams {
                 col: 0,
             });
         }
-        if let Some((k, j)) = bad_coef(&std_path).or_else(|| bad_coef(&coef_path)) {
+        if let Some((k, j)) = bad_coef(&std_path).or_else(|| bad_coef(orig)) {
             return Err(Error::NonFinite {
                 what: "path coefficients (knot, feature; an intermediate value overflowed: \
                        rescale X or y)",
@@ -450,6 +452,25 @@ impl LarsParams {
             y_mean,
         })
     }
+}
+
+/// The knot-major buffer (`knots` rows of `p`) as a `knots x p` matrix, transposed by tiles
+/// of 64 knots so that both sides stream through the cache.
+fn knots_by_features(flat: &[f64], knots: usize, p: usize) -> DMatrix<f64> {
+    const TILE: usize = 64;
+    let mut m = DMatrix::zeros(knots, p);
+    let dst = m.as_mut_slice();
+    let mut k0 = 0;
+    while k0 < knots {
+        let k1 = (k0 + TILE).min(knots);
+        for j in 0..p {
+            for k in k0..k1 {
+                dst[j * knots + k] = flat[k * p + j];
+            }
+        }
+        k0 = k1;
+    }
+    m
 }
 
 /// The index at which the running sum of `values` first stops being finite (the last index if

@@ -22,6 +22,8 @@ pub(super) struct Core<'a> {
     p: usize,
     /// `X^T X` (column-major p x p), when precomputed.
     gram: Option<Vec<f64>>,
+    /// `X^T y`, computed with the Gram matrix.
+    xty: Option<Vec<f64>>,
     /// `||x_j||^2`.
     sq_norms: Vec<f64>,
     /// Scratch without the Gram matrix: the equiangular vector `u = X_A w` (length n), the
@@ -37,9 +39,15 @@ pub(super) struct Core<'a> {
 }
 
 impl<'a> Core<'a> {
-    pub(super) fn new(xs: &'a DMatrix<f64>, use_gram: bool) -> Self {
+    /// With `use_gram`, `X^T X` and `X^T ys` are computed here, in one pass over `X`.
+    pub(super) fn new(xs: &'a DMatrix<f64>, ys: &[f64], use_gram: bool) -> Self {
         let (n, p) = xs.shape();
-        let gram = use_gram.then(|| kernels::gram(xs.as_slice(), n, p));
+        let (gram, xty) = if use_gram {
+            let (g, xty) = kernels::gram(xs.as_slice(), n, p, ys);
+            (Some(g), Some(xty))
+        } else {
+            (None, None)
+        };
         let sq_norms = match &gram {
             Some(g) => (0..p).map(|j| g[j * p + j]).collect(),
             None => (0..p)
@@ -54,6 +62,7 @@ impl<'a> Core<'a> {
             n,
             p,
             gram,
+            xty,
             sq_norms,
             u: vec![0.0; if use_gram { 0 } else { n }],
             inactive: Vec::with_capacity(p),
@@ -186,7 +195,11 @@ impl<'a> Core<'a> {
         let p = self.p;
         let nf = self.n as f64;
         let mut c = vec![0.0; p];
-        {
+        if let Some(xty) = &self.xty {
+            for j in (0..p).filter(|&j| eligible[j]) {
+                c[j] = xty[j];
+            }
+        } else {
             let cols: Vec<usize> = (0..p).filter(|&j| eligible[j]).collect();
             let mut cc = vec![0.0; cols.len()];
             kernels::dots(self.xs.as_slice(), self.n, &cols, ys, &mut cc);
