@@ -214,7 +214,10 @@ impl<'a> Core<'a> {
 
         let mut beta = vec![0.0; p];
         let mut alphas = vec![c0 / nf];
-        let mut coefs = beta.clone();
+        // room for the knots of a full LAR path (the lasso may need more), within reason
+        let knots_guess = self.n.min(p).min(params.max_steps.unwrap_or(usize::MAX)) + 2;
+        let mut coefs = Vec::with_capacity(p.saturating_mul(knots_guess).min(1 << 24));
+        coefs.extend_from_slice(&beta);
         let mut events = Vec::new();
         let mut active: Vec<usize> = Vec::new();
         let mut signs: Vec<f64> = Vec::new();
@@ -349,12 +352,9 @@ impl<'a> Core<'a> {
             // --- step length --------------------------------------------------------------
             let gamma_hat = big_c / aa;
             let mut gamma = gamma_hat;
-            let mut any_inactive = false;
-            for j in 0..p {
-                if !eligible[j] || is_active[j] {
-                    continue;
-                }
-                any_inactive = true;
+            // `self.inactive`: the eligible inactive columns, listed for the correlations
+            let any_inactive = !self.inactive.is_empty();
+            for &j in &self.inactive {
                 let dropped_now = just_dropped.contains(&j);
                 for side in [1.0, -1.0] {
                     // a just-dropped variable sits exactly at |c_j| = C on its own side
@@ -363,7 +363,9 @@ impl<'a> Core<'a> {
                     }
                     let num = big_c - side * c[j];
                     let den = aa - side * a[j];
-                    if num > 0.0 && den > 0.0 {
+                    // the division only when it may shorten the step: num / den < gamma
+                    // implies num < gamma den (1 + 4 eps) whatever the rounding
+                    if num > 0.0 && den > 0.0 && num < gamma * den * (1.0 + 4.0 * f64::EPSILON) {
                         let g = num / den;
                         if g < gamma {
                             gamma = g;
