@@ -74,7 +74,7 @@ impl CholeskyFactor {
         };
         let k = row.len() - 1;
         debug_assert_eq!(z.len(), k);
-        let s = kernels::dot4(&row[..k], &z[..k]);
+        let s = kernels::forward_dot(row, z, k);
         z.push((b_last - s) / row[k]);
     }
 
@@ -145,17 +145,33 @@ mod tests {
 
     #[test]
     fn forward_extend_equals_a_full_forward_solve_bit_for_bit() {
-        let g = gram();
+        // 21 variables: several blocks of the blocked forward solve
+        let x = DMatrix::from_fn(40, 21, |i, j| {
+            ((i * 31 + j * 17) as f64 * 0.7).sin() + 0.3 * ((i * j) as f64).cos()
+        });
+        let g = x.transpose() * &x;
         let mut f = CholeskyFactor::default();
-        let b = [1.0, -1.0, 1.0, 1.0];
+        let b: Vec<f64> = (0..21)
+            .map(|j| if j % 3 == 0 { -1.0 } else { 1.0 })
+            .collect();
         let mut z = Vec::new();
-        for j in 0..4 {
+        for j in 0..21 {
             let col: Vec<f64> = (0..j).map(|i| g[(i, j)]).collect();
             assert_eq!(f.append(&col, g[(j, j)], 1e-12), Append::Appended);
             f.forward_extend(&mut z, b[j]);
             let mut full = b[..=j].to_vec();
             f.forward_in_place(&mut full);
-            assert_eq!(z, full);
+            assert_eq!(z, full, "{j} variables");
+        }
+        // and the solve is right: G x = b against nalgebra's LU
+        let mut sol = b.clone();
+        f.solve_in_place(&mut sol);
+        let want = g
+            .lu()
+            .solve(&nalgebra::DVector::from_column_slice(&b))
+            .unwrap();
+        for (a, r) in sol.iter().zip(want.iter()) {
+            assert!((a - r).abs() < 1e-9 * r.abs().max(1.0), "{a} vs {r}");
         }
     }
 

@@ -36,8 +36,7 @@ fn dot_with<S: Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
     dots_with::<S, 1>(simd, [&a[..n]], &b[..n])[0]
 }
 
-/// `a . b` with four chains (the latency-bound rows of a triangular solve); its own
-/// summation order, used by both [`forward`] and [`dot4`].
+/// `a . b` with four chains (the latency-bound rows of a triangular solve).
 #[inline(always)]
 fn dot4_with<S: Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
     let n = a.len().min(b.len());
@@ -61,21 +60,6 @@ fn dot4_with<S: Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
         r += x * y;
     }
     r
-}
-
-struct Dot4<'a>(&'a [f64], &'a [f64]);
-
-impl WithSimd for Dot4<'_> {
-    type Output = f64;
-    #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) -> f64 {
-        dot4_with(simd, self.0, self.1)
-    }
-}
-
-/// `a . b` in the order of the triangular solves (see [`dot4_with`]).
-pub(crate) fn dot4(a: &[f64], b: &[f64]) -> f64 {
-    arch().dispatch(Dot4(a, b))
 }
 
 struct Dot<'a>(&'a [f64], &'a [f64]);
@@ -349,6 +333,23 @@ pub(crate) fn combine(data: &[f64], n: usize, cols: &[usize], w: &[f64], out: &m
 // ---------------------------------------------------------------------------------------
 // triangular solves with a row-stored lower-triangular factor
 
+/// Rows per block of the forward solve: the dot products of a block's rows with the part of
+/// the solution solved before the block are independent, so they overlap in the pipeline
+/// instead of waiting for each other's reductions.
+const SOLVE_BLOCK: usize = 8;
+
+/// `row[..i] . b[..i]` as the forward solve takes it: the part before `i`'s block by a
+/// vector dot product, the rest in order.
+#[inline(always)]
+fn forward_dot_with<S: Simd>(simd: S, row: &[f64], b: &[f64], i: usize) -> f64 {
+    let i0 = i / SOLVE_BLOCK * SOLVE_BLOCK;
+    let mut s = dot4_with(simd, &row[..i0], &b[..i0]);
+    for (r, x) in row[i0..i].iter().zip(&b[i0..i]) {
+        s += r * x;
+    }
+    s
+}
+
 struct Forward<'a> {
     rows: &'a [Vec<f64>],
     b: &'a mut [f64],
@@ -359,9 +360,23 @@ impl WithSimd for Forward<'_> {
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) {
         let Forward { rows, b } = self;
-        for (i, row) in rows.iter().enumerate() {
-            let s = dot4_with(simd, &row[..i], &b[..i]);
-            b[i] = (b[i] - s) / row[i];
+        let mut i0 = 0;
+        while i0 < rows.len() {
+            let i1 = (i0 + SOLVE_BLOCK).min(rows.len());
+            // the block's dot products with b[..i0] first (independent of each other) ...
+            let mut head = [0.0; SOLVE_BLOCK];
+            for (h, row) in head.iter_mut().zip(&rows[i0..i1]) {
+                *h = dot4_with(simd, &row[..i0], &b[..i0]);
+            }
+            // ... then the triangle inside the block, in order (= forward_dot_with)
+            for (i, row) in rows.iter().enumerate().take(i1).skip(i0) {
+                let mut s = head[i - i0];
+                for (r, x) in row[i0..i].iter().zip(&b[i0..i]) {
+                    s += r * x;
+                }
+                b[i] = (b[i] - s) / row[i];
+            }
+            i0 = i1;
         }
     }
 }
@@ -370,6 +385,21 @@ impl WithSimd for Forward<'_> {
 /// solve).
 pub(crate) fn forward(rows: &[Vec<f64>], b: &mut [f64]) {
     arch().dispatch(Forward { rows, b });
+}
+
+struct ForwardDot<'a>(&'a [f64], &'a [f64], usize);
+
+impl WithSimd for ForwardDot<'_> {
+    type Output = f64;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> f64 {
+        forward_dot_with(simd, self.0, self.1, self.2)
+    }
+}
+
+/// `row[..i] . b[..i]` bit for bit as [`forward`] computes it for row `i`.
+pub(crate) fn forward_dot(row: &[f64], b: &[f64], i: usize) -> f64 {
+    arch().dispatch(ForwardDot(row, b, i))
 }
 
 struct Backward<'a> {
