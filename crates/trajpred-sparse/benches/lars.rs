@@ -1,12 +1,13 @@
-//! Criterion benchmarks: the full LAR path on Gaussian data (442x10, 2000x100, 5000x500).
+//! Criterion benchmarks: the full LAR path on Gaussian data (442x10, 2000x100, 5000x500, and
+//! the wide 200x1000). For the comparison with scikit-learn, `benches/lars_timing.rs` times
+//! the same fits with the protocol of the peer script (`benches/compare.sh` runs both).
 //!
 //! The data come from a counter-based generator (splitmix64 + Box-Muller) that
 //! `benches/sklearn_lars_path.py` reproduces in numpy, so scikit-learn's `lars_path` is timed
-//! on the same matrices. Run both in the same sitting:
+//! on the same matrices.
 //!
 //! ```text
-//! CARGO_TARGET_DIR=/work/target-sparse cargo bench -p trajpred-sparse -- --warm-up-time 1 --measurement-time 3
-//! OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 /work/venv/bin/python crates/trajpred-sparse/benches/sklearn_lars_path.py
+//! cargo bench -p trajpred-sparse --bench lars -- --warm-up-time 1 --measurement-time 3
 //! ```
 #![allow(missing_docs)]
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
@@ -46,7 +47,7 @@ pub fn data(n: usize, p: usize) -> (DMatrix<f64>, Vec<f64>) {
 fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("lar_full_path");
     group.sample_size(10);
-    for (n, p) in [(442, 10), (2000, 100), (5000, 500)] {
+    for (n, p) in [(442, 10), (2000, 100), (5000, 500), (200, 1000)] {
         let (x, y) = data(n, p);
         let params = Lars::params()
             .method(Method::Lar)

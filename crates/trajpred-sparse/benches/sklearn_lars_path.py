@@ -1,21 +1,40 @@
 """Times scikit-learn's lars_path (method='lar', full path) on the benchmark data of
-benches/lars.rs (same counter-based generator: splitmix64 + Box-Muller), single-threaded.
+benches/lars.rs and benches/lars_timing.rs (same counter-based generator: splitmix64 +
+Box-Muller), with one BLAS thread.
 
-Run: OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 /work/venv/bin/python \
-     crates/trajpred-sparse/benches/sklearn_lars_path.py
+Two configurations per size, as benches/lars_timing.rs times ours:
+- gram: `lars_path(X, y, Gram='auto')`: the Gram matrix X^T X is computed inside the timed
+  call when n_samples > n_features (what `sklearn.linear_model.Lars` does by default);
+  for p > n it is not, and the path runs on X;
+- no_gram: `lars_path(X, y, Gram=None)`: every step works on X.
+
+Each configuration is timed `reps` times (after one untimed warm-up run); the script prints
+the median, the quartiles and the extremes of the wall-clock time, and the thread's CPU time
+over the timed runs divided by reps (which leaves out waiting for a core on a shared machine),
+in milliseconds.
+`max_iter=min(n, p)`: the number of steps our path takes (for p > n it stops when the
+residual correlation vanishes, after n steps; scikit-learn's default max_iter=500 would take
+300 more steps past the exact fit). The timing protocol is the one
+of benches/lars_timing.rs.
+
+Run: /tmp/venv-sk/bin/python crates/trajpred-sparse/benches/sklearn_lars_path.py [--quick]
 """
 import os
+import sys
 import time
 import warnings
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("MKL_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 import sklearn  # noqa: E402
 from sklearn.linear_model import lars_path  # noqa: E402
+from threadpoolctl import threadpool_info, threadpool_limits  # noqa: E402
 
 GOLDEN = np.uint64(0x9E3779B97F4A7C15)
+CASES = [(442, 10), (2000, 100), (5000, 500), (200, 1000)]
 
 
 def splitmix(k):
@@ -43,22 +62,53 @@ def data(n, p):
     return X, y
 
 
+def reps_for(n, p, quick):
+    """The same repetition counts as benches/lars_timing.rs."""
+    work = n * p * min(n, p)
+    if quick:
+        return 3
+    if work >= 10**9:
+        return 11
+    if work >= 10**7:
+        return 31
+    return 201
+
+
+def summary(times):
+    t = np.sort(np.asarray(times)) * 1e3
+    q1, med, q3 = np.percentile(t, [25, 50, 75])
+    return f"median {med:.4f} ms  IQR [{q1:.4f}, {q3:.4f}]  range [{t[0]:.4f}, {t[-1]:.4f}]  n={len(t)}"
+
+
 def main():
+    quick = "--quick" in sys.argv
     warnings.simplefilter("ignore")
-    print(f"scikit-learn {sklearn.__version__}, numpy {np.__version__}, single-threaded BLAS")
-    for n, p in [(442, 10), (2000, 100), (5000, 500)]:
-        X, y = data(n, p)
-        alphas, _, _ = lars_path(X, y, method="lar")
-        reps = 5 if p >= 500 else 50
-        best = float("inf")
-        times = []
-        for _ in range(reps):
-            t = time.perf_counter()
-            lars_path(X, y, method="lar")
-            dt = time.perf_counter() - t
-            times.append(dt)
-            best = min(best, dt)
-        print(f"{n}x{p}: {len(alphas)} knots, median {np.median(times)*1e3:.3f} ms, best {best*1e3:.3f} ms")
+    with threadpool_limits(limits=1):
+        blas = ", ".join(
+            f"{i['internal_api']} {i.get('version')} threads={i['num_threads']}"
+            for i in threadpool_info()
+        )
+        print(f"# scikit-learn {sklearn.__version__}, numpy {np.__version__}, BLAS: {blas}")
+        for n, p in CASES:
+            X, y = data(n, p)
+            reps = reps_for(n, p, quick)
+            for label, gram in [("gram", "auto"), ("no_gram", None)]:
+                # as many steps as ours takes (min(n, p)): for p <= n the default full path;
+                # for p > n sklearn's default max_iter=500 would go on past the exact fit
+                steps = min(n, p)
+                alphas, _, _ = lars_path(X, y, method="lar", Gram=gram, max_iter=steps)  # warm-up
+                times = []
+                c = time.thread_time()
+                for _ in range(reps):
+                    t = time.perf_counter()
+                    lars_path(X, y, method="lar", Gram=gram, max_iter=steps)
+                    times.append(time.perf_counter() - t)
+                cpu_mean = (time.thread_time() - c) / reps
+                print(
+                    f"sklearn {label:8} {n}x{p}: {len(alphas)} knots, {summary(times)}"
+                    f"  cpu mean {cpu_mean * 1e3:.4f} ms",
+                    flush=True,
+                )
 
 
 if __name__ == "__main__":

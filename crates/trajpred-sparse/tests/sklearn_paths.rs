@@ -235,3 +235,78 @@ fn collinear_and_duplicate_columns_are_excluded_and_reported() {
     assert_eq!(fit.stop_reason(), StopReason::CorrelationVanished);
     assert!(fit.coef_path().iter().all(|v| v.is_finite()));
 }
+
+#[test]
+fn lars_path_returns_sklearns_values_in_sklearns_layout() {
+    use trajpred_sparse::{LarsPathOptions, lars_path};
+    let f = fixture();
+    for name in [
+        "diabetes_lar",
+        "diabetes_lasso",
+        "diabetes_lasso_alpha_min",
+        "diabetes_lar_max_iter",
+        "correlated_lasso",
+    ] {
+        let c = case(&f, name);
+        let x = matrix(&c["x"]);
+        let y = vector(&c["y"]);
+        let mut opts = LarsPathOptions::default();
+        if let Some(m) = c["kwargs"]["max_iter"].as_u64() {
+            opts = opts.max_iter(m as usize);
+        }
+        if let Some(a) = c["kwargs"]["alpha_min"].as_f64() {
+            opts = opts.alpha_min(a);
+        }
+        let path = lars_path(&x, &y, method(c), &opts).expect("path");
+        let alphas = vector(&c["alphas"]);
+        // the fixture stores coefs knot by knot; scikit-learn returns them n_features x n_alphas
+        let coefs_t = matrix(&c["coefs"]);
+        assert_eq!(path.alphas.len(), alphas.len(), "{name}: n_alphas");
+        assert_eq!(path.n_iter, alphas.len() - 1, "{name}: n_iter");
+        assert_eq!(
+            path.coefs.shape(),
+            (x.ncols(), alphas.len()),
+            "{name}: layout"
+        );
+        let active: Vec<usize> = serde_json::from_value(c["active"].clone()).expect("active");
+        assert_eq!(path.active, active, "{name}: active");
+        let err = rel_err(&path.alphas, &alphas, alphas[0] * 1e-3);
+        assert!(err < 1e-9, "{name}: alphas differ by {err:e}");
+        let c_max = coefs_t.amax();
+        for k in 0..alphas.len() {
+            let ours: Vec<f64> = path.coefs.column(k).iter().copied().collect();
+            let theirs: Vec<f64> = coefs_t.row(k).iter().copied().collect();
+            let err = rel_err(&ours, &theirs, c_max * 1e-3);
+            assert!(
+                err < 1e-9,
+                "{name}: alpha {k} coefficients differ by {err:e}"
+            );
+        }
+    }
+}
+
+#[test]
+fn lars_path_rejects_a_bad_alpha_min() {
+    use trajpred_sparse::{Error, LarsPathOptions, lars_path};
+    let f = fixture();
+    let c = case(&f, "diabetes_lar");
+    let (x, y) = (matrix(&c["x"]), vector(&c["y"]));
+    for bad in [-1.0, f64::NAN, f64::INFINITY] {
+        let r = lars_path(
+            &x,
+            &y,
+            Method::Lar,
+            &LarsPathOptions::default().alpha_min(bad),
+        );
+        assert!(
+            matches!(
+                r,
+                Err(Error::InvalidParameter {
+                    name: "alpha_min",
+                    ..
+                })
+            ),
+            "{bad}"
+        );
+    }
+}

@@ -1,0 +1,79 @@
+//! Tests of the dense kernels against plain loops.
+use super::*;
+
+fn matrix(n: usize, p: usize) -> Vec<f64> {
+    (0..n * p)
+        .map(|k| ((k * 7919 % 1013) as f64 - 506.0) / 97.0)
+        .collect()
+}
+
+fn naive_dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-12 * (1.0 + a.abs().max(b.abs()))
+}
+
+#[test]
+fn kernels_agree_with_plain_loops_on_awkward_sizes() {
+    // sizes around the vector widths, the four-column groups and the row panels
+    for &(n, p) in &[
+        (1, 1),
+        (3, 2),
+        (17, 5),
+        (31, 9),
+        (64, 4),
+        (515, 7),
+        (1030, 13),
+    ] {
+        let x = matrix(n, p);
+        let v: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let cols: Vec<usize> = (0..p).rev().collect();
+        let mut out = vec![0.0; p];
+        dots(&x, n, &cols, &v, &mut out);
+        for (k, &j) in cols.iter().enumerate() {
+            let want = naive_dot(&x[j * n..(j + 1) * n], &v);
+            assert!(close(out[k], want), "dots {n}x{p} col {j}");
+            assert!(close(dot(&x[j * n..(j + 1) * n], &v), want), "dot {n}x{p}");
+        }
+        let w: Vec<f64> = (0..p).map(|k| 1.0 - 0.3 * k as f64).collect();
+        let mut u = vec![f64::NAN; n];
+        combine(&x, n, &cols, &w, &mut u);
+        for i in 0..n {
+            let want: f64 = cols.iter().zip(&w).map(|(&j, wk)| wk * x[j * n + i]).sum();
+            assert!(close(u[i], want), "combine {n}x{p} row {i}");
+        }
+        let b: Vec<f64> = (0..p).map(|k| 0.25 * k as f64 - 0.5).collect();
+        let mut rd = vec![f64::NAN; p];
+        residual_dots(&x, n, &cols, &b, &v, &mut rd);
+        let resid: Vec<f64> = (0..n)
+            .map(|i| {
+                v[i] - cols
+                    .iter()
+                    .zip(&b)
+                    .map(|(&j, bk)| bk * x[j * n + i])
+                    .sum::<f64>()
+            })
+            .collect();
+        for (k, &j) in cols.iter().enumerate() {
+            let want = naive_dot(&x[j * n..(j + 1) * n], &resid);
+            assert!(
+                (rd[k] - want).abs() <= 1e-10 * (1.0 + want.abs()),
+                "residual_dots {n}x{p} col {j}: {} vs {want}",
+                rd[k]
+            );
+        }
+        let (g, xtv) = gram(&x, n, p, &v);
+        for j in 0..p {
+            let want = naive_dot(&x[j * n..(j + 1) * n], &v);
+            assert!(close(xtv[j], want), "gram X^T v {n}x{p} col {j}");
+        }
+        for i in 0..p {
+            for j in 0..p {
+                let want = naive_dot(&x[i * n..(i + 1) * n], &x[j * n..(j + 1) * n]);
+                assert!(close(g[j * p + i], want), "gram {n}x{p} ({i}, {j})");
+            }
+        }
+    }
+}

@@ -1,0 +1,457 @@
+//! The path itself, on the standardised problem: the LAR / lasso steps with an incrementally
+//! updated Cholesky factor, with or without the Gram matrix, and the final refinement.
+
+use super::{Exclusion, ExclusionReason, LarsParams, Method, PathEvent, StopReason};
+use crate::cholesky::{Append, CholeskyFactor};
+use crate::kernels::{self, dot};
+use nalgebra::DMatrix;
+
+pub(super) struct Path {
+    pub(super) alphas: Vec<f64>,
+    /// knot after knot, `p` coefficients each
+    pub(super) coefs: Vec<f64>,
+    pub(super) events: Vec<PathEvent>,
+    pub(super) active: Vec<usize>,
+    pub(super) stop: StopReason,
+    pub(super) chol: CholeskyFactor,
+}
+
+pub(super) struct Core<'a> {
+    xs: &'a DMatrix<f64>,
+    n: usize,
+    p: usize,
+    /// `X^T X` (column-major p x p), when precomputed.
+    gram: Option<Vec<f64>>,
+    /// `X^T y`, computed with the Gram matrix.
+    xty: Option<Vec<f64>>,
+    /// `||x_j||^2`.
+    sq_norms: Vec<f64>,
+    /// Scratch without the Gram matrix: the equiangular vector `u = X_A w` (length n), the
+    /// eligible inactive columns and their `a_j`.
+    u: Vec<f64>,
+    inactive: Vec<usize>,
+    a_inactive: Vec<f64>,
+    /// With the Gram matrix: `G[gc_rows, :]` (column-major), a superset of the inactive
+    /// columns' rows, and which columns it has rows for.
+    gc: Vec<f64>,
+    gc_rows: Vec<usize>,
+    in_gc: Vec<bool>,
+}
+
+impl<'a> Core<'a> {
+    /// With `use_gram`, `X^T X` and `X^T ys` are computed here, in one pass over `X`.
+    pub(super) fn new(xs: &'a DMatrix<f64>, ys: &[f64], use_gram: bool) -> Self {
+        let (n, p) = xs.shape();
+        let (gram, xty) = if use_gram {
+            let (g, xty) = kernels::gram(xs.as_slice(), n, p, ys);
+            (Some(g), Some(xty))
+        } else {
+            (None, None)
+        };
+        let sq_norms = match &gram {
+            Some(g) => (0..p).map(|j| g[j * p + j]).collect(),
+            None => (0..p)
+                .map(|j| {
+                    let c = &xs.as_slice()[j * n..(j + 1) * n];
+                    dot(c, c)
+                })
+                .collect(),
+        };
+        Core {
+            xs,
+            n,
+            p,
+            gram,
+            xty,
+            sq_norms,
+            u: vec![0.0; if use_gram { 0 } else { n }],
+            inactive: Vec::with_capacity(p),
+            a_inactive: Vec::with_capacity(p),
+            gc: Vec::new(),
+            gc_rows: Vec::new(),
+            in_gc: vec![false; p],
+        }
+    }
+
+    fn col(&self, j: usize) -> &[f64] {
+        &self.xs.as_slice()[j * self.n..(j + 1) * self.n]
+    }
+
+    /// `G[A, j]` in the order of `active`.
+    fn gram_with_active(&self, active: &[usize], j: usize, out: &mut Vec<f64>) {
+        out.clear();
+        match &self.gram {
+            Some(g) => out.extend(active.iter().map(|&a| g[j * self.p + a])),
+            None => {
+                out.resize(active.len(), 0.0);
+                kernels::dots(self.xs.as_slice(), self.n, active, self.col(j), out);
+            }
+        }
+    }
+
+    /// `a = X^T X_A w` for the eligible inactive columns (from the Gram matrix's rows of
+    /// those columns, or from `u = X_A w`), and `a_j = aa s_j` (eq. 2.6) on the active set.
+    #[allow(clippy::too_many_arguments)]
+    fn equiangular_correlations(
+        &mut self,
+        active: &[usize],
+        w: &[f64],
+        signs: &[f64],
+        aa: f64,
+        usable: impl Fn(usize) -> bool,
+        a: &mut [f64],
+    ) {
+        self.inactive.clear();
+        self.inactive.extend((0..self.p).filter(|&j| usable(j)));
+        match &self.gram {
+            Some(g) => {
+                // rows of G for the inactive columns only (sklearn keeps them apart by
+                // swapping rows of G): a compacted copy, rebuilt when a quarter of its rows
+                // has become active or a dropped column needs a row it lacks
+                let p = self.p;
+                let stale = self.inactive.len() * 4 < self.gc_rows.len() * 3
+                    || self.inactive.iter().any(|&j| !self.in_gc[j]);
+                if stale {
+                    self.gc_rows.clone_from(&self.inactive);
+                    self.in_gc.iter_mut().for_each(|v| *v = false);
+                    for &j in &self.gc_rows {
+                        self.in_gc[j] = true;
+                    }
+                    let m = self.gc_rows.len();
+                    self.gc.resize(m * p, 0.0);
+                    for (k, gk) in self.gc.chunks_exact_mut(m.max(1)).enumerate().take(p) {
+                        let src = &g[k * p..(k + 1) * p];
+                        for (dst, &j) in gk.iter_mut().zip(&self.gc_rows) {
+                            *dst = src[j];
+                        }
+                    }
+                }
+                let m = self.gc_rows.len();
+                self.a_inactive.resize(m, 0.0);
+                if m > 0 {
+                    kernels::combine(&self.gc, m, active, w, &mut self.a_inactive);
+                }
+                a.fill(0.0);
+                for (&j, &v) in self.gc_rows.iter().zip(&self.a_inactive) {
+                    a[j] = v;
+                }
+            }
+            None => {
+                let data = self.xs.as_slice();
+                kernels::combine(data, self.n, active, w, &mut self.u);
+                self.a_inactive.resize(self.inactive.len(), 0.0);
+                kernels::dots(data, self.n, &self.inactive, &self.u, &mut self.a_inactive);
+                a.fill(0.0);
+                for (&j, &v) in self.inactive.iter().zip(&self.a_inactive) {
+                    a[j] = v;
+                }
+            }
+        }
+        for (&j, &s) in active.iter().zip(signs) {
+            a[j] = aa * s;
+        }
+    }
+
+    /// Iterative refinement of the least-squares fit on the active set at the end of a full
+    /// path: `beta_A += G_AA^{-1} X_A^T (y - X_A beta_A)`, with the residual recomputed from
+    /// `X` each time. The path's incremental updates work on the normal equations, whose
+    /// rounding grows with cond(X)^2; two refinement sweeps bring the end point to the
+    /// accuracy of a least-squares solve (cond(X) * eps for a small residual).
+    pub(super) fn refine(
+        &self,
+        active: &[usize],
+        chol: &CholeskyFactor,
+        ys: &[f64],
+        beta: &mut [f64],
+    ) {
+        if active.is_empty() || chol.len() != active.len() {
+            return;
+        }
+        let data = self.xs.as_slice();
+        let mut delta = vec![0.0; active.len()];
+        let mut b = vec![0.0; active.len()];
+        for _ in 0..2 {
+            for (bk, &k) in b.iter_mut().zip(active) {
+                *bk = beta[k];
+            }
+            kernels::residual_dots(data, self.n, active, &b, ys, &mut delta);
+            chol.solve_in_place(&mut delta);
+            if delta.iter().any(|d| !d.is_finite()) {
+                return;
+            }
+            for (&k, d) in active.iter().zip(&delta) {
+                beta[k] += d;
+            }
+        }
+    }
+
+    pub(super) fn run(
+        &mut self,
+        params: &LarsParams,
+        ys: &[f64],
+        mut eligible: Vec<bool>,
+        excluded: &mut Vec<Exclusion>,
+    ) -> Path {
+        let p = self.p;
+        let nf = self.n as f64;
+        let mut c = vec![0.0; p];
+        if let Some(xty) = &self.xty {
+            for j in (0..p).filter(|&j| eligible[j]) {
+                c[j] = xty[j];
+            }
+        } else {
+            let cols: Vec<usize> = (0..p).filter(|&j| eligible[j]).collect();
+            let mut cc = vec![0.0; cols.len()];
+            kernels::dots(self.xs.as_slice(), self.n, &cols, ys, &mut cc);
+            for (&j, v) in cols.iter().zip(cc) {
+                c[j] = v;
+            }
+        }
+        let c0 = (0..p)
+            .filter(|&j| eligible[j])
+            .map(|j| c[j].abs())
+            .fold(0.0, f64::max);
+
+        let mut beta = vec![0.0; p];
+        let mut alphas = vec![c0 / nf];
+        // room for the knots of a full LAR path (the lasso may need more), within reason
+        let knots_guess = self.n.min(p).min(params.max_steps.unwrap_or(usize::MAX)) + 2;
+        let mut coefs = Vec::with_capacity(p.saturating_mul(knots_guess).min(1 << 24));
+        coefs.extend_from_slice(&beta);
+        let mut events = Vec::new();
+        let mut active: Vec<usize> = Vec::new();
+        let mut signs: Vec<f64> = Vec::new();
+        let mut is_active = vec![false; p];
+        let mut chol = CholeskyFactor::default();
+        // z = L^{-1} s, extended on each entry, recomputed after drops (the downdate changes L)
+        let mut z: Vec<f64> = Vec::new();
+        let mut z_stale = false;
+        let mut just_dropped: Vec<usize> = Vec::new();
+        let mut big_c = c0;
+        let mut step = 0usize;
+        let mut scratch = Vec::new();
+        let mut a = vec![0.0; p];
+
+        let finish = |alphas, coefs, events, active, stop, chol| Path {
+            alphas,
+            coefs,
+            events,
+            active,
+            stop,
+            chol,
+        };
+
+        if c0.is_nan() || c0 <= 0.0 {
+            alphas[0] = 0.0;
+            return finish(
+                alphas,
+                coefs,
+                events,
+                active,
+                StopReason::CorrelationVanished,
+                chol,
+            );
+        }
+        if c0 / nf <= params.alpha_min {
+            alphas[0] = params.alpha_min;
+            return finish(alphas, coefs, events, active, StopReason::AlphaMin, chol);
+        }
+
+        loop {
+            if big_c <= params.vanish_tolerance * c0 {
+                return finish(
+                    alphas,
+                    coefs,
+                    events,
+                    active,
+                    StopReason::CorrelationVanished,
+                    chol,
+                );
+            }
+            if params.max_steps.is_some_and(|m| step >= m) {
+                return finish(alphas, coefs, events, active, StopReason::MaxSteps, chol);
+            }
+            step += 1;
+
+            // --- variables that tie for the largest correlation enter -------------------------
+            let threshold = big_c * (1.0 - params.tie_tolerance);
+            let mut candidates: Vec<usize> = (0..p)
+                .filter(|&j| {
+                    eligible[j]
+                        && !is_active[j]
+                        && !just_dropped.contains(&j)
+                        && c[j].abs() >= threshold
+                })
+                .collect();
+            candidates.sort_by(|&i, &j| c[j].abs().total_cmp(&c[i].abs()).then(i.cmp(&j)));
+            if z_stale {
+                z.clone_from(&signs);
+                chol.forward_in_place(&mut z);
+                z_stale = false;
+            }
+            for j in candidates {
+                self.gram_with_active(&active, j, &mut scratch);
+                match chol.append(&scratch, self.sq_norms[j], params.collinearity_tolerance) {
+                    Append::Appended => {
+                        active.push(j);
+                        let sj = if c[j] >= 0.0 { 1.0 } else { -1.0 };
+                        signs.push(sj);
+                        // the factor grew by one row: z = L^{-1} s grows by one entry, the
+                        // same value a full forward solve would give
+                        chol.forward_extend(&mut z, sj);
+                        is_active[j] = true;
+                        events.push(PathEvent::Added { feature: j, step });
+                    }
+                    Append::Collinear => {
+                        eligible[j] = false;
+                        excluded.push(Exclusion {
+                            feature: j,
+                            reason: ExclusionReason::Collinear,
+                            step,
+                        });
+                        log::debug!("LARS step {step}: column {j} is collinear, excluded");
+                    }
+                }
+            }
+            if active.is_empty() {
+                return finish(
+                    alphas,
+                    coefs,
+                    events,
+                    active,
+                    StopReason::CorrelationVanished,
+                    chol,
+                );
+            }
+
+            // --- equiangular direction: w = AA G_AA^{-1} s ---------------------------------
+            let mut w = z.clone();
+            chol.backward_in_place(&mut w);
+            let q: f64 = w.iter().zip(&signs).map(|(wi, si)| wi * si).sum();
+            if !(q.is_finite() && q > 0.0) {
+                return finish(
+                    alphas,
+                    coefs,
+                    events,
+                    active,
+                    StopReason::NumericalBreakdown,
+                    chol,
+                );
+            }
+            let aa = 1.0 / q.sqrt();
+            w.iter_mut().for_each(|v| *v *= aa);
+            self.equiangular_correlations(
+                &active,
+                &w,
+                &signs,
+                aa,
+                |j| eligible[j] && !is_active[j],
+                &mut a,
+            );
+
+            // --- step length --------------------------------------------------------------
+            let gamma_hat = big_c / aa;
+            let mut gamma = gamma_hat;
+            // `self.inactive`: the eligible inactive columns, listed for the correlations
+            let any_inactive = !self.inactive.is_empty();
+            for &j in &self.inactive {
+                let dropped_now = just_dropped.contains(&j);
+                for side in [1.0, -1.0] {
+                    // a just-dropped variable sits exactly at |c_j| = C on its own side
+                    if dropped_now && side * c[j] > 0.0 {
+                        continue;
+                    }
+                    let num = big_c - side * c[j];
+                    let den = aa - side * a[j];
+                    // the division only when it may shorten the step: num / den < gamma
+                    // implies num < gamma den (1 + 4 eps) whatever the rounding
+                    if num > 0.0 && den > 0.0 && num < gamma * den * (1.0 + 4.0 * f64::EPSILON) {
+                        let g = num / den;
+                        if g < gamma {
+                            gamma = g;
+                        }
+                    }
+                }
+            }
+            // lasso: the first active coefficient to reach zero
+            let mut drops: Vec<usize> = Vec::new(); // positions in `active`
+            if params.method == Method::Lasso {
+                let mut z_min = f64::INFINITY;
+                for (pos, &j) in active.iter().enumerate() {
+                    if w[pos] != 0.0 {
+                        let z = -beta[j] / w[pos];
+                        if z > 0.0 && z < z_min {
+                            z_min = z;
+                        }
+                    }
+                }
+                if z_min < gamma {
+                    gamma = z_min;
+                    for (pos, &j) in active.iter().enumerate() {
+                        if w[pos] != 0.0 {
+                            let z = -beta[j] / w[pos];
+                            if z > 0.0 && z <= z_min * (1.0 + 1e-12) {
+                                drops.push(pos);
+                            }
+                        }
+                    }
+                }
+            }
+            let full_step = drops.is_empty() && gamma >= gamma_hat;
+
+            // --- move -------------------------------------------------------------------
+            for (pos, &j) in active.iter().enumerate() {
+                beta[j] += gamma * w[pos];
+            }
+            for (cj, aj) in c.iter_mut().zip(&a) {
+                *cj -= gamma * aj;
+            }
+            big_c = if full_step {
+                0.0
+            } else {
+                (big_c - gamma * aa).max(0.0)
+            };
+
+            just_dropped.clear();
+            for &pos in drops.iter().rev() {
+                let j = active.remove(pos);
+                signs.remove(pos);
+                chol.remove(pos);
+                z_stale = true;
+                is_active[j] = false;
+                beta[j] = 0.0;
+                just_dropped.push(j);
+                events.push(PathEvent::Dropped { feature: j, step });
+            }
+
+            let alpha = big_c / nf;
+            let prev_alpha = alphas[alphas.len() - 1];
+            if params.alpha_min > 0.0 && alpha <= params.alpha_min {
+                let prev = &coefs[coefs.len() - p..];
+                let ss = if prev_alpha > alpha {
+                    (prev_alpha - params.alpha_min) / (prev_alpha - alpha)
+                } else {
+                    1.0
+                };
+                let knot: Vec<f64> = prev
+                    .iter()
+                    .zip(&beta)
+                    .map(|(b0, b1)| b0 + ss * (b1 - b0))
+                    .collect();
+                alphas.push(params.alpha_min);
+                coefs.extend_from_slice(&knot);
+                return finish(alphas, coefs, events, active, StopReason::AlphaMin, chol);
+            }
+            alphas.push(alpha);
+            coefs.extend_from_slice(&beta);
+            if full_step {
+                let stop = if any_inactive {
+                    StopReason::CorrelationVanished
+                } else {
+                    StopReason::Complete
+                };
+                return finish(alphas, coefs, events, active, stop, chol);
+            }
+        }
+    }
+}
