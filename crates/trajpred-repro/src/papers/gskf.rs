@@ -27,17 +27,6 @@ use trajpred_data::synthetic::gskf_eq20;
 use trajpred_metrics::{error_statistics, euclidean_errors, rmse, rmse_3d};
 use trajpred_neural::{LstmNet, Mlp};
 
-/// Why this paper's numbers and ours differ (shown in the results index).
-pub const EXPLANATION: &str = "Eq. 20 without noise is a sum of sinusoids, which a linear \
-recurrence of order 2 (x) or 4 (y, z) reproduces exactly; GSC fits that recurrence by LAR, so \
-for m >= 4 GSC and MSTPM-GSKF predict the noiseless test part to rounding error, far below \
-the paper's millimetre-level RMSE. The paper's errors are those of a model that does not fit \
-the recurrence exactly (its eq. 19 has no intercept, and it may have used noisy data, other \
-LAR stopping or another sampling); we report what the faithful implementation gives and tune \
-nothing toward the paper's numbers. The noise experiment (Fig. 4) is where the methods \
-separate. BP and LSTM are trained with the paper's plain gradient descent at learning rate 0.1; \
-their numbers depend on initialisation and float summation order.";
-
 /// Points of the trajectory used for training (`docs/papers.md` A.5).
 pub const TRAIN_POINTS: usize = 800;
 /// Test points at the end of the trajectory (`docs/papers.md` A.5).

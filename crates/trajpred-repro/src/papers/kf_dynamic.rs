@@ -36,16 +36,6 @@ mod tables;
 use claims::claims;
 use tables::{headline, tables_and_figures};
 
-/// Why this paper's numbers and ours differ (shown in the results index).
-pub const EXPLANATION: &str = "Why the KF-dynamic numbers differ from the paper's: we run on \
-subsets of GeoLife and T-Drive, not the full datasets, so our test sets are smaller than the \
-paper's; the paper's T-Drive rule (drop trajectories sampled more than a few seconds apart) \
-leaves almost nothing of T-Drive, which mostly reports every few minutes, so T-Drive is split \
-at a longer gap (stated in the run's notes) and its steps are minutes long; the paper does not \
-say how its error is averaged over histories and steps, which parameter set gives its headline \
-figures, how the HMM is trained, nor how irregular sampling is handled. Our choices are in \
-docs/kf-dynamic.md.";
-
 /// History lengths of the paper's Table 1.
 const HISTORIES: [usize; 5] = [10, 20, 30, 40, 50];
 /// Forecast steps 1..=HORIZON.

@@ -38,15 +38,6 @@ use trajpred_data::synthetic::PatentCurve;
 use trajpred_data::{LoadOptions, Projection, adsb};
 use trajpred_neural::{EpochReport, KfuLstmNet, LstmNet, RnnNet};
 
-/// Why this paper's numbers and ours differ (shown in the results index).
-pub const EXPLANATION: &str = "The patent's Table 3 (RMSE of RNN, LSTM and KFU-LSTM) and its \
-table of curve equations are not in the document: the three curves (helix, 3-D Lissajous \
-figure-eight, climbing spiral with a turn onto a level leg), the noise level, the real flight \
-window, the epoch counts and the baselines' window length are ours, so only the ranking can be \
-compared with the patent's claim. Training is shortened to fit the run-time budget (KFU at \
-learning rate 1e-3 rather than 1e-4), F is the identity, and the baselines learn from noisy \
-targets while the KFU-LSTM-Net is trained against the clean truth, as decided in docs/papers.md D.";
-
 /// Standard deviation (m) of the Gaussian noise on every axis of the simulated curves.
 pub const CURVE_SIGMA: f64 = 0.5;
 
