@@ -58,6 +58,15 @@ pub enum ReproError {
         /// What was wrong.
         reason: String,
     },
+    /// A paper's spec (`papers/<slug>.toml`) cannot be read, is inconsistent, or does not fit
+    /// what the run produced.
+    #[error("spec of {paper}: {reason}")]
+    Spec {
+        /// The paper's slug.
+        paper: String,
+        /// What was wrong.
+        reason: String,
+    },
     /// `--check`: a fresh run differs from the committed one (every difference is listed).
     #[error(
         "{paper}: {} difference(s) from the run committed in {}:{}",

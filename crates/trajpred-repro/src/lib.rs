@@ -26,6 +26,8 @@
 pub mod error;
 pub mod papers;
 pub mod report;
+pub mod runner;
+pub mod spec;
 
 pub use error::{ReproError, Result};
 pub use report::{
@@ -34,7 +36,27 @@ pub use report::{
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 use std::time::Instant;
+
+/// The specs of the four papers (`papers/<slug>.toml`), in the order of [`Paper::ALL`].
+const SPECS: [&str; 4] = [
+    include_str!("../papers/gskf.toml"),
+    include_str!("../papers/kf-dynamic.toml"),
+    include_str!("../papers/mkpf.toml"),
+    include_str!("../papers/kfu-lstm.toml"),
+];
+
+/// The parsed specs (or why one cannot be read), parsed once.
+fn parsed() -> &'static [std::result::Result<spec::Spec, String>] {
+    static PARSED: OnceLock<Vec<std::result::Result<spec::Spec, String>>> = OnceLock::new();
+    PARSED.get_or_init(|| {
+        SPECS
+            .iter()
+            .map(|text| spec::Spec::parse(text).map_err(|e| e.to_string()))
+            .collect()
+    })
+}
 
 /// One of the four papers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -63,18 +85,26 @@ impl Paper {
         }
     }
 
-    /// The paper's title.
-    pub fn title(self) -> &'static str {
-        match self {
-            Paper::Gskf => {
-                "MSTPM-GSKF: multi-step prediction by group sparse coding and an improved Kalman filter (docs/papers.md A)"
-            }
-            Paper::KfDynamic => {
-                "Dynamic trajectory prediction with a Kalman filter (docs/papers.md B)"
-            }
-            Paper::Mkpf => "MKPF: a particle filter with a UKF+EKF proposal (docs/papers.md C)",
-            Paper::KfuLstm => "KFU-LSTM-Net: a Kalman-filter-unfolded LSTM (docs/papers.md D)",
+    /// The paper's spec (`papers/<slug>.toml`): its datasets, parameters, methods, tables,
+    /// figures and claims.
+    pub fn spec(self) -> Result<&'static spec::Spec> {
+        let i = Paper::ALL.iter().position(|p| *p == self).unwrap_or(0);
+        match parsed().get(i) {
+            Some(Ok(s)) => Ok(s),
+            Some(Err(reason)) => Err(ReproError::Spec {
+                paper: self.slug().to_string(),
+                reason: reason.clone(),
+            }),
+            None => Err(ReproError::Spec {
+                paper: self.slug().to_string(),
+                reason: "no spec".into(),
+            }),
         }
+    }
+
+    /// The paper's title (from its spec; the slug if the spec cannot be read).
+    pub fn title(self) -> &'static str {
+        self.spec().map_or(self.slug(), |s| s.title.as_str())
     }
 
     /// Parses a slug.
@@ -83,14 +113,9 @@ impl Paper {
     }
 
     /// Why this paper's numbers and ours can differ, for the results index (no numbers here:
-    /// those come from the run).
+    /// those come from the run; from the spec, empty if it cannot be read).
     pub fn explanation(self) -> &'static str {
-        match self {
-            Paper::Gskf => papers::gskf::EXPLANATION,
-            Paper::KfDynamic => papers::kf_dynamic::EXPLANATION,
-            Paper::Mkpf => papers::mkpf::EXPLANATION,
-            Paper::KfuLstm => papers::kfu_lstm::EXPLANATION,
-        }
+        self.spec().map_or("", |s| s.explanation.as_str())
     }
 }
 

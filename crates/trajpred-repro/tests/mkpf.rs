@@ -97,8 +97,8 @@ fn ukf_cell_matches_an_independent_computation() {
         .expect("CT UKF row");
 
     // rerun the UKF directly and recompute the paper's formula and the RMSE by hand
-    let setup = Setup::default();
-    let flight = synthetic_flight(ctx.seed, true, setup.position_sd).expect("flight");
+    let setup = Setup::paper().expect("the spec's settings");
+    let flight = synthetic_flight(ctx.seed, true, &setup).expect("flight");
     let noise = choose_noise(&flight, &setup, Motion::Ct).expect("noise");
     let run = run_method(&flight, &setup, Motion::Ct, &noise, Method::Ukf, 0).expect("ukf");
     assert!(!run.frames.is_empty());
@@ -134,7 +134,8 @@ fn ukf_cell_matches_an_independent_computation() {
 
 #[test]
 fn local_frame_round_trip_is_exact() {
-    let flight = synthetic_flight(3, true, 15.0).expect("flight");
+    let setup = Setup::paper().expect("the spec's settings");
+    let flight = synthetic_flight(3, true, &setup).expect("flight");
     let frame = local_frame(&flight).expect("frame");
     for p in flight.truth.iter().step_by(25) {
         let back = to_geodetic(&frame, to_local(&frame, *p).expect("local"));
@@ -162,7 +163,8 @@ fn same_seed_same_tables() {
 #[test]
 fn real_flight_rule_picks_a_long_clean_flight() {
     let Some(d) = data_dir() else { return };
-    let choice = load_flight(&d.join("adsb-traffic"), Some(200)).expect("flight");
+    let setup = Setup::paper().expect("the spec's settings");
+    let choice = load_flight(&d.join("adsb-traffic"), &setup, Some(200)).expect("flight");
     assert_eq!(choice.flight.times.len(), 200);
     // fresh reports only: no position repeats the previous one
     assert!(choice.flight.observed.windows(2).all(|w| w[0] != w[1]));

@@ -4,68 +4,34 @@
 //! MKPF) and in metres. Compared: the MKPF, the bootstrap PF with the same particle count
 //! (and ten times as many), the UKF and the EKF, each with a constant-velocity and a
 //! coordinated-turn model. A synthetic coordinated-turn flight runs the same protocol without
-//! data. The experiment itself is in [`experiment`]; `docs/mkpf.md` says what the paper left
-//! open and what we chose.
+//! data. The paper's tables, figures and claims are in its spec (`papers/mkpf.toml`); this
+//! module runs the experiment ([`experiment`]) and hands the numbers to the runner.
+//! `docs/mkpf.md` says what the paper left open and what we chose.
 
 pub mod experiment;
+mod flight;
+mod models;
 
-use crate::report::{Figure, PaperResult, Table, Value};
-use crate::{Context, Result};
+use crate::report::{Figure, PaperResult, Value};
+use crate::runner::{Computed, Row, assemble};
+use crate::{Context, Paper, Result};
 use experiment::{
-    ACCEL_GRID, ADSB_FILE, Flight, INITIAL_SPEED_SD, MAX_GAP_S, MAX_Q_CONDITION, Method, Motion,
-    Noise, Run, Setup, TURN_GRID, TURN_RATE_SD_GRID, choose_noise, load_flight, run_method,
+    Flight, Method, Motion, Noise, Run, Setup, choose_noise, kept_frames, load_flight, run_method,
     synthetic_flight,
 };
+use serde::Deserialize;
 use trajpred::plot::{Chart, Series};
 
-/// Why this paper's numbers and ours differ (shown in the results index).
-pub const EXPLANATION: &str = "The paper reports a single relative error for the MKPF on an \
-undisclosed BeiDou flight, with no figures for other filters, no noise levels and no particle \
-count. We run its protocol (keep one frame in every fifty, predict the frames in between from \
-the kept ones, relative error on geodetic coordinates) on a public ADS-B flight with stated \
-noise levels, a process noise chosen by likelihood on the kept frames only, and report the \
-error in metres beside it, because the relative error on latitude and longitude mostly \
-measures how far the aircraft is from the equator and the Greenwich meridian.";
-
-/// The paper's relative error of the MKPF, percent (`docs/papers.md` C.2).
-const PAPER_RELATIVE_ERROR_PCT: f64 = 0.03;
-
-/// Particles of the MKPF and of the bootstrap PF it is compared with.
-const PARTICLES: usize = 100;
-/// The second bootstrap PF has this many times as many particles.
-const BOOTSTRAP_FACTOR: usize = 10;
-
-struct Settings {
+/// The run sizes (`[budget]` of the spec).
+#[derive(Debug, Clone, Deserialize)]
+struct Budget {
+    /// Seeds per particle filter.
     seeds: usize,
+    /// A synthetic flight of half the length.
     synthetic_quick: bool,
+    /// Cut the real flight to this many frames.
+    #[serde(default)]
     real_frames: Option<usize>,
-}
-
-fn settings(ctx: &Context) -> Settings {
-    if ctx.quick {
-        Settings {
-            seeds: 2,
-            synthetic_quick: true,
-            real_frames: Some(751),
-        }
-    } else {
-        Settings {
-            seeds: 5,
-            synthetic_quick: false,
-            real_frames: None,
-        }
-    }
-}
-
-fn methods() -> [Method; 6] {
-    [
-        Method::Mkpf(PARTICLES),
-        Method::MkpfConditioned(PARTICLES),
-        Method::Bootstrap(PARTICLES),
-        Method::Bootstrap(PARTICLES * BOOTSTRAP_FACTOR),
-        Method::Ukf,
-        Method::Ekf,
-    ]
 }
 
 /// All runs of one method and motion model on one flight.
@@ -73,6 +39,8 @@ fn methods() -> [Method; 6] {
 pub struct MethodRuns {
     /// The motion model.
     pub motion: Motion,
+    /// The method's key in the spec.
+    pub key: String,
     /// The method.
     pub method: Method,
     /// One run per seed (one run for the Kalman filters).
@@ -90,38 +58,35 @@ fn mean_sd(v: &[f64]) -> (f64, f64) {
     (m, var.sqrt())
 }
 
-/// Summary numbers of one row.
-#[derive(Debug, Clone, Copy)]
-struct Summary {
-    rel_pct: (f64, f64),
-    rmse: (f64, f64),
-    mean_m: f64,
-    max_m: f64,
-    seconds: f64,
-}
-
-fn summarize(rows: &MethodRuns) -> Result<Summary> {
+/// The row of one method and motion model: the cells of the spec's results table.
+fn summary_row(r: &MethodRuns) -> Result<Row> {
     let mut rel = Vec::new();
     let mut rmse = Vec::new();
     let mut mean_m = Vec::new();
     let mut max_m = Vec::new();
     let mut secs = Vec::new();
-    for r in &rows.runs {
-        rel.push(100.0 * r.relative_error()?);
-        let e = r.errors_m();
+    for run in &r.runs {
+        rel.push(100.0 * run.relative_error()?);
+        let e = run.errors_m();
         let n = e.len().max(1) as f64;
         rmse.push((e.iter().map(|x| x * x).sum::<f64>() / n).sqrt());
         mean_m.push(e.iter().sum::<f64>() / n);
         max_m.push(e.iter().copied().fold(0.0, f64::max));
-        secs.push(r.seconds);
+        secs.push(run.seconds);
     }
-    Ok(Summary {
-        rel_pct: mean_sd(&rel),
-        rmse: mean_sd(&rmse),
-        mean_m: mean_sd(&mean_m).0,
-        max_m: mean_sd(&max_m).0,
-        seconds: mean_sd(&secs).0,
-    })
+    let (rel, rel_sd) = mean_sd(&rel);
+    let (rmse, rmse_sd) = mean_sd(&rmse);
+    Ok(
+        Row::new(format!("{}-{}", r.motion.name().to_lowercase(), r.key))
+            .set("runs", r.runs.len())
+            .set("rel", rel)
+            .set("rel_sd", rel_sd)
+            .set("rmse", rmse)
+            .set("rmse_sd", rmse_sd)
+            .set("mean", mean_sd(&mean_m).0)
+            .set("max", mean_sd(&max_m).0)
+            .set("seconds", mean_sd(&secs).0),
+    )
 }
 
 /// Everything run on one flight.
@@ -135,17 +100,22 @@ pub struct FlightResult {
     pub rows: Vec<MethodRuns>,
 }
 
-/// Runs every method and motion model on `flight`.
-pub fn run_flight(ctx: &Context, flight: Flight, seeds: usize, tag: &str) -> Result<FlightResult> {
-    let setup = Setup::default();
+/// Runs every method of the spec and both motion models on `flight`.
+fn run_flight(
+    ctx: &Context,
+    setup: &Setup,
+    methods: &[(String, Method)],
+    flight: Flight,
+    seeds: usize,
+    tag: &str,
+) -> Result<FlightResult> {
     let mut noise = Vec::new();
     let mut rows = Vec::new();
-    let ms = methods();
-    let bar = ctx.bar((2 * ms.len()) as u64, format!("mkpf {tag}"));
+    let bar = ctx.bar((2 * methods.len()) as u64, format!("mkpf {tag}"));
     for motion in [Motion::Cv, Motion::Ct] {
-        let q = choose_noise(&flight, &setup, motion)?;
+        let q = choose_noise(&flight, setup, motion)?;
         noise.push((motion, q));
-        for method in ms {
+        for (key, method) in methods {
             let n = if method.particles().is_some() {
                 seeds
             } else {
@@ -156,12 +126,13 @@ pub fn run_flight(ctx: &Context, flight: Flight, seeds: usize, tag: &str) -> Res
                     let seed = ctx
                         .seed
                         .wrapping_add((i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
-                    run_method(&flight, &setup, motion, &q, method, seed)
+                    run_method(&flight, setup, motion, &q, *method, seed)
                 })
                 .collect::<Result<Vec<_>>>()?;
             rows.push(MethodRuns {
                 motion,
-                method,
+                key: key.clone(),
+                method: *method,
                 runs,
             });
             bar.inc(1);
@@ -175,95 +146,37 @@ pub fn run_flight(ctx: &Context, flight: Flight, seeds: usize, tag: &str) -> Res
     })
 }
 
-fn results_table(id: &str, title: &str, res: &FlightResult, paper: bool) -> Result<Table> {
-    let mut t = Table::new(id, title)
-        .label("model")
-        .label("method")
-        .label("particles")
-        .ours("runs", 0, 0.0, 0.0)
-        .ours("relative error (%)", 5, 1e-15, 1e-9)
-        .paper("relative error (%), paper", 2)
-        .ours("relative error sd (%)", 5, 1e-15, 1e-9)
-        .ours("RMSE (m)", 1, 1e-9, 1e-9)
-        .ours("RMSE sd (m)", 1, 1e-9, 1e-9)
-        .ours("mean error (m)", 1, 1e-9, 1e-9)
-        .ours("max error (m)", 1, 1e-9, 1e-9)
-        .timing("wall time per run (s)", 3);
+/// The numbers of the results table `id` and the noise table `noise_id` of one flight.
+fn tables(
+    out: &mut Computed,
+    id: &str,
+    noise_id: &str,
+    res: &FlightResult,
+    setup: &Setup,
+) -> Result<()> {
+    let t = out.table(id);
     for r in &res.rows {
-        let s = summarize(r)?;
-        let paper_value = match (paper, r.method) {
-            (true, Method::Mkpf(_)) => Value::Num(PAPER_RELATIVE_ERROR_PCT),
-            _ => Value::Missing,
-        };
-        t.push(vec![
-            r.motion.name().into(),
-            r.method.name().into(),
-            r.method
-                .particles()
-                .map_or_else(|| "-".to_string(), |n| n.to_string())
-                .into(),
-            r.runs.len().into(),
-            s.rel_pct.0.into(),
-            paper_value,
-            s.rel_pct.1.into(),
-            s.rmse.0.into(),
-            s.rmse.1.into(),
-            s.mean_m.into(),
-            s.max_m.into(),
-            s.seconds.into(),
-        ])?;
+        t.rows.push(summary_row(r)?);
     }
-    t.note(format!(
-        "{}: {} frames; one frame in every {} kept ({} kept), the frames in between predicted \
-         from the kept frames only and compared with the true frames; the frames before the \
-         second kept frame are not evaluated (the filters start from a position without \
-         velocity).",
-        res.flight.name,
-        res.flight.times.len(),
-        Setup::default().keep_every,
-        experiment::kept_frames(res.flight.times.len(), Setup::default().keep_every).len(),
-    ));
-    t.note(
-        "Relative error: the paper's sqrt(mean(((x_hat - x)/x)^2)) over latitude and longitude \
-         (degrees) of every evaluated frame, in percent. Metres: horizontal Euclidean error in \
-         the local east-north frame. Particle filters: mean over seeds, sd = sample standard \
-         deviation over seeds; the Kalman filters are deterministic (one run).",
-    );
-    Ok(t)
-}
-
-fn noise_table(id: &str, title: &str, res: &FlightResult) -> Result<Table> {
-    let mut t = Table::new(id, title)
-        .label("model")
-        .ours("acceleration noise (m^2/s^3)", 3, 0.0, 1e-12)
-        .ours("turn-rate noise (rad^2/s^3)", 9, 0.0, 1e-12)
-        .ours("initial turn-rate sd (rad/s)", 3, 0.0, 1e-12)
-        .ours("log-likelihood of the kept frames", 2, 1e-9, 1e-9);
+    let n = res.flight.times.len();
+    t.var("flight", res.flight.name.as_str());
+    t.var("frames", n);
+    t.var("kept", kept_frames(n, setup.keep_every).len());
+    let t = out.table(noise_id);
     for (m, q) in &res.noise {
-        t.push(vec![
-            m.name().into(),
-            q.accel.into(),
-            match m {
-                Motion::Cv => Value::Missing,
-                Motion::Ct => q.turn.into(),
-            },
-            match m {
-                Motion::Cv => Value::Missing,
-                Motion::Ct => q.turn_rate_sd.into(),
-            },
-            q.log_likelihood.into(),
-        ])?;
+        let ct = |x: f64| match m {
+            Motion::Cv => Value::Missing,
+            Motion::Ct => x.into(),
+        };
+        t.rows.push(
+            Row::new(m.name().to_lowercase())
+                .set("accel", q.accel)
+                .set("turn", ct(q.turn))
+                .set("turn_rate_sd", ct(q.turn_rate_sd))
+                .set("ll", q.log_likelihood),
+        );
     }
-    t.note(format!(
-        "Chosen by the UKF log-likelihood of the kept frames only (never the compared frames), \
-         over the grid {ACCEL_GRID:?} (continuous white-noise acceleration, per axis) and, for \
-         the coordinated turn, {TURN_GRID:?} (turn-rate random walk) with the initial turn-rate sd \
-         in {TURN_RATE_SD_GRID:?}; coordinated-turn noises whose Q has a condition number over \
-         {MAX_Q_CONDITION:e} are skipped. Observation noise fixed \
-         at sd {} m per axis.",
-        experiment::POSITION_SD_M
-    ));
-    Ok(t)
+    Ok(())
 }
 
 fn find(res: &FlightResult, motion: Motion, method: Method) -> Option<&MethodRuns> {
@@ -272,7 +185,7 @@ fn find(res: &FlightResult, motion: Motion, method: Method) -> Option<&MethodRun
         .find(|r| r.motion == motion && r.method == method)
 }
 
-fn figures(id: &str, what: &str, res: &FlightResult) -> Vec<Figure> {
+fn figures(id: &str, what: &str, res: &FlightResult, particles: usize) -> Vec<Figure> {
     let mut out = Vec::new();
     let Some(truth_run) = find(res, Motion::Ct, Method::Ukf).and_then(|r| r.runs.first()) else {
         return out;
@@ -283,9 +196,9 @@ fn figures(id: &str, what: &str, res: &FlightResult) -> Vec<Figure> {
         markers: false,
     }];
     for method in [
-        Method::Mkpf(PARTICLES),
+        Method::Mkpf(particles),
         Method::Ukf,
-        Method::Bootstrap(PARTICLES),
+        Method::Bootstrap(particles),
     ] {
         if let Some(run) = find(res, Motion::Ct, method).and_then(|r| r.runs.first()) {
             series.push(Series {
@@ -312,8 +225,8 @@ fn figures(id: &str, what: &str, res: &FlightResult) -> Vec<Figure> {
     let t0 = res.flight.times.first().copied().unwrap_or(0.0);
     let mut series = Vec::new();
     for method in [
-        Method::Mkpf(PARTICLES),
-        Method::Bootstrap(PARTICLES),
+        Method::Mkpf(particles),
+        Method::Bootstrap(particles),
         Method::Ukf,
         Method::Ekf,
     ] {
@@ -347,192 +260,47 @@ fn figures(id: &str, what: &str, res: &FlightResult) -> Vec<Figure> {
     out
 }
 
-/// Claims on one flight; `label` names it in the statements.
-fn claims(
-    result: &mut PaperResult,
-    res: &FlightResult,
-    label: &str,
-    about_paper: bool,
-) -> Result<()> {
-    let rmse = |motion, method| -> Result<Option<f64>> {
-        match find(res, motion, method) {
-            Some(r) => Ok(Some(summarize(r)?.rmse.0)),
-            None => Ok(None),
-        }
-    };
-    let rel = |motion| -> Result<Option<f64>> {
-        match find(res, motion, Method::Mkpf(PARTICLES)) {
-            Some(r) => Ok(Some(summarize(r)?.rel_pct.0)),
-            None => Ok(None),
-        }
-    };
-    if about_paper {
-        let (cv, ct) = (rel(Motion::Cv)?, rel(Motion::Ct)?);
-        if let (Some(cv), Some(ct)) = (cv, ct) {
-            let best = cv.min(ct);
-            result.claim(
-                format!(
-                    "{label}: the MKPF's relative error is about the paper's \
-                     {PAPER_RELATIVE_ERROR_PCT}% (within a factor of two, better model)"
-                ),
-                (PAPER_RELATIVE_ERROR_PCT / 2.0..=PAPER_RELATIVE_ERROR_PCT * 2.0).contains(&best),
-                format!("MKPF relative error: CV {cv:.5}%, CT {ct:.5}% (paper {PAPER_RELATIVE_ERROR_PCT}%)"),
-            );
-        }
-    }
-    let mut beats = |other: Method, what: &str| -> Result<()> {
-        let mut holds = true;
-        let mut ev = Vec::new();
-        for motion in [Motion::Cv, Motion::Ct] {
-            let (Some(a), Some(b)) = (rmse(motion, Method::Mkpf(PARTICLES))?, rmse(motion, other)?)
-            else {
-                continue;
-            };
-            holds &= a < b;
-            ev.push(format!(
-                "{}: MKPF {a:.1} m vs {} {b:.1} m",
-                motion.name(),
-                other.name()
-            ));
-        }
-        result.claim(
-            format!("{label}: the MKPF beats {what} (RMSE in metres, both models)"),
-            holds,
-            ev.join("; "),
-        );
-        Ok(())
-    };
-    beats(
-        Method::Bootstrap(PARTICLES),
-        &format!("the bootstrap PF with the same particle count ({PARTICLES})"),
-    )?;
-    beats(Method::Ukf, "the UKF")?;
-    beats(Method::Ekf, "the EKF")?;
-    Ok(())
-}
-
-/// Runs the paper's experiments.
+/// Runs the paper's experiments and builds its report from the spec.
 pub fn run(ctx: &Context) -> Result<PaperResult> {
-    let s = settings(ctx);
-    let mut result = PaperResult::new();
-    let setup = Setup::default();
+    let spec = Paper::Mkpf.spec()?;
+    let setup: Setup = spec.params()?;
+    let budget: Budget = spec.budget_as(ctx.quick)?;
+    let methods = spec
+        .methods
+        .iter()
+        .map(|m| Ok((m.key.clone(), Method::from_spec(m)?)))
+        .collect::<Result<Vec<_>>>()?;
+    let mut out = Computed::default();
 
     // the synthetic flight always runs
-    let synthetic = synthetic_flight(ctx.seed, s.synthetic_quick, setup.position_sd)?;
-    result.data.push(format!(
+    let synthetic = synthetic_flight(ctx.seed, budget.synthetic_quick, &setup)?;
+    out.data.push(format!(
         "{} (generated, seed {}): {} frames",
         synthetic.name,
         ctx.seed,
         synthetic.times.len()
     ));
-    let syn = run_flight(ctx, synthetic, s.seeds, "synthetic")?;
+    let syn = run_flight(ctx, &setup, &methods, synthetic, budget.seeds, "synthetic")?;
 
     // the real flight when the data is present
-    let real = match ctx.data("adsb-traffic") {
-        Some(dir) => {
-            let choice = load_flight(&dir, s.real_frames)?;
-            result.data.push(choice.description.clone());
-            Some(run_flight(ctx, choice.flight, s.seeds, "ADS-B")?)
-        }
-        None => {
-            result.missing.push(ctx.missing(
-                "adsb-traffic",
-                &format!(
-                    "mkpf/table1 and the flight figures (one frame in every {} of the longest \
-                     clean flight of {ADSB_FILE}, MKPF vs bootstrap PF, UKF, EKF)",
-                    setup.keep_every
-                ),
-            ));
-            None
-        }
-    };
-
-    if let Some(real) = &real {
-        result.tables.push(results_table(
-            "table1",
-            "Table 1: one frame in 50 kept, the in-between frames predicted, real ADS-B flight \
-             (relative error on latitude/longitude and horizontal error in metres)",
-            real,
-            true,
-        )?);
-        result.tables.push(noise_table(
-            "table1_noise",
-            "Table 1b: process noise of each model, chosen on the kept frames of the real flight",
-            real,
-        )?);
-        result
-            .figures
-            .extend(figures("fig_flight", "ADS-B flight", real));
-        claims(&mut result, real, "real flight", true)?;
+    if let Some(dir) = out.locate(spec, ctx, "adsb")? {
+        let choice = load_flight(&dir, &setup, budget.real_frames)?;
+        out.data.push(choice.description.clone());
+        let real = run_flight(ctx, &setup, &methods, choice.flight, budget.seeds, "ADS-B")?;
+        tables(&mut out, "table1", "table1_noise", &real, &setup)?;
+        out.figures.extend(figures(
+            "fig_flight",
+            "ADS-B flight",
+            &real,
+            setup.particles,
+        ));
     }
-    result.tables.push(results_table(
-        "table2",
-        "Table 2: the same protocol on a synthetic coordinated-turn flight (truth known without \
-         noise)",
+    tables(&mut out, "table2", "table2_noise", &syn, &setup)?;
+    out.figures.extend(figures(
+        "fig_synthetic",
+        "synthetic flight",
         &syn,
-        false,
-    )?);
-    result.tables.push(noise_table(
-        "table2_noise",
-        "Table 2b: process noise of each model, chosen on the kept frames of the synthetic flight",
-        &syn,
-    )?);
-    result
-        .figures
-        .extend(figures("fig_synthetic", "synthetic flight", &syn));
-    claims(&mut result, &syn, "synthetic flight", real.is_none())?;
-
-    result.notes.extend(notes(&s, &setup));
-    Ok(result)
-}
-
-fn notes(s: &Settings, setup: &Setup) -> Vec<String> {
-    vec![
-        "The relative error on geodetic coordinates is a weak measure: it divides each error in \
-         degrees by the latitude or longitude itself, so the same error in metres gives a \
-         smaller relative error far from the equator (latitude) and a much larger one near the \
-         Greenwich meridian (longitude); it says where the flight is as much as how good the \
-         filter is. The error in metres is the measure to compare filters; the relative error \
-         is reported only to stand beside the paper's figure."
-            .to_string(),
-        "Why our numbers differ from the paper's: its flight (BeiDou reports), its sampling \
-         interval, its noise levels, its motion model and its particle count are not given, and \
-         it reports no baseline. A slower report rate or a straighter flight gives smaller \
-         errors with the same protocol."
-            .to_string(),
-        format!(
-            "Flight: {ADSB_FILE}, the longest run of fresh position reports (repeated positions \
-             dropped, split at gaps over {MAX_GAP_S} s). Filtering in local east-north metres \
-             (tangent plane at the first report, height 0); predictions converted back to \
-             latitude/longitude for the relative error. Altitude is not filtered (the \
-             coordinated turn is a horizontal model)."
-        ),
-        format!(
-            "Noise: observation sd {} m per axis (a stated ADS-B accuracy, not fitted); process \
-             noise chosen per model by the UKF likelihood of the kept frames only (Tables 1b, \
-             2b), shared by all four filters. Initial state: the first kept position, zero \
-             velocity with sd {INITIAL_SPEED_SD} m/s per axis, turn rate 0 with the sd chosen \
-             with the process noise.",
-            setup.position_sd
-        ),
-        format!(
-            "Particle filters: the MKPF and the bootstrap PF with {PARTICLES} particles each, \
-             and a bootstrap PF with {} particles; residual resampling at every step (the \
-             paper); MKPF with the crate's defaults (carried particle covariances, augmented \
-             UKF, relinearised EKF stage, Merwe sigma points alpha 1e-3, beta 2, kappa 0), and \
-             once more with the conditioned particle prior (docs/particle.md). The \
-             step between kept frames varies with the report times, so the filters are rebuilt \
-             for each new step with the same particles; the MKPF's particles then all carry the \
-             mean of their covariances (exact for the linear CV model, an approximation for the \
-             coordinated turn). In-between positions of the particle filters are the weighted \
-             means of the particles pushed through the model without noise. {} seeds per \
-             particle filter.",
-            PARTICLES * BOOTSTRAP_FACTOR,
-            s.seeds
-        ),
-        "Reproducibility: every random number comes from seeded ChaCha8 generators; the \
-         particle filters draw them sequentially, so the tables do not depend on the number of \
-         rayon threads; --check compares them with a relative tolerance of 1e-9."
-            .to_string(),
-    ]
+        setup.particles,
+    ));
+    assemble(spec, ctx, out)
 }

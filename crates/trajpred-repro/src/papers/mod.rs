@@ -1,5 +1,5 @@
-//! One module per paper; each has `run(&Context) -> Result<PaperResult>` and an
-//! `EXPLANATION` for the results index.
+//! One module per paper: `run(&Context) -> Result<PaperResult>` computes the paper's numbers
+//! and hands them, with the paper's spec (`papers/<slug>.toml`), to [`crate::runner`].
 
 pub mod gskf;
 pub mod kf_dynamic;
