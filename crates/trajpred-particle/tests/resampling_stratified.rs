@@ -66,31 +66,7 @@ fn stratified_equals_the_definition_for_its_uniforms() {
 /// zero weights never picked.
 #[test]
 fn stratified_gives_the_same_indices_on_any_thread_count() {
-    let len = (1 << 18) + 3;
-    let mut wrng = ChaCha8Rng::seed_from_u64(5);
-    let w: Vec<f64> = (0..len)
-        .map(|i| {
-            if i % 5 == 0 {
-                0.0
-            } else {
-                wrng.random::<f64>()
-            }
-        })
-        .collect();
-    for n in [len, (1 << 17) + 3, 2 * len] {
-        let run = |threads: usize| {
-            pool(threads).install(|| {
-                Stratified
-                    .resample(&w, n, &mut ChaCha8Rng::seed_from_u64(9))
-                    .expect("resample")
-            })
-        };
-        let one = run(1);
-        assert!(one.windows(2).all(|p| p[0] <= p[1]), "sorted, n {n}");
-        assert!(one.iter().all(|&i| w[i] > 0.0), "zero weight picked, n {n}");
-        assert!(run(2) == one, "2 threads, n {n}");
-        assert!(run(3) == one, "3 threads, n {n}");
-    }
+    common::assert_same_indices_on_any_thread_count(&Stratified);
 }
 
 /// Independent strata: with two particles per stratum, `w_2j = f_j` and `w_2j+1 = 1 - f_j`

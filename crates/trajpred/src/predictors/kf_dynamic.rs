@@ -253,6 +253,37 @@ fn forecast(
     run(params, history, horizon, form, method)
 }
 
+/// The constructor and the [`Predictor`] of [`KfDynamic`] and [`NaiveKf`], which differ
+/// only in their name and in the [`Form`] they run.
+macro_rules! kf_predictor {
+    ($ty:ident, $name:literal, $form:expr) => {
+        impl $ty {
+            /// A validated predictor (q, r, p0 finite and positive).
+            pub fn new(params: KfDynamicParams) -> Result<Self> {
+                params.validate()?;
+                Ok($ty { params })
+            }
+        }
+
+        impl Predictor for $ty {
+            fn name(&self) -> &str {
+                $name
+            }
+            fn fit(&mut self, _train: &[Trajectory]) -> Result<()> {
+                Ok(())
+            }
+            fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
+                check_forecast_args(history, horizon, self.min_history())?;
+                let form = $form(&self.params);
+                forecast(&self.params, history, horizon, form, self.name())
+            }
+            fn min_history(&self) -> usize {
+                2
+            }
+        }
+    };
+}
+
 /// "KF dynamic" (eq. 13-15): the one-step-ahead predictor form of the Kalman filter, run
 /// through the history; the first forecast step uses the latest observation, and the later
 /// ones follow [`KfDynamicParams::multi_step`] (by default prediction alone, which gives
@@ -278,30 +309,9 @@ pub struct KfDynamic {
     params: KfDynamicParams,
 }
 
-impl KfDynamic {
-    /// A validated predictor (q, r, p0 finite and positive).
-    pub fn new(params: KfDynamicParams) -> Result<Self> {
-        params.validate()?;
-        Ok(KfDynamic { params })
-    }
-}
-
-impl Predictor for KfDynamic {
-    fn name(&self) -> &str {
-        "kf-dynamic"
-    }
-    fn fit(&mut self, _train: &[Trajectory]) -> Result<()> {
-        Ok(())
-    }
-    fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
-        check_forecast_args(history, horizon, self.min_history())?;
-        let form = Form::Predictor(self.params.multi_step);
-        forecast(&self.params, history, horizon, form, self.name())
-    }
-    fn min_history(&self) -> usize {
-        2
-    }
-}
+kf_predictor!(KfDynamic, "kf-dynamic", |p: &KfDynamicParams| {
+    Form::Predictor(p.multi_step)
+});
 
 /// The paper's "naive KF": the standard Kalman filter through the history, then
 /// `X(k+1) = A X(k)` from the last filtered state, with no correction.
@@ -310,26 +320,4 @@ pub struct NaiveKf {
     params: KfDynamicParams,
 }
 
-impl NaiveKf {
-    /// A validated predictor (q, r, p0 finite and positive).
-    pub fn new(params: KfDynamicParams) -> Result<Self> {
-        params.validate()?;
-        Ok(NaiveKf { params })
-    }
-}
-
-impl Predictor for NaiveKf {
-    fn name(&self) -> &str {
-        "naive-kf"
-    }
-    fn fit(&mut self, _train: &[Trajectory]) -> Result<()> {
-        Ok(())
-    }
-    fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
-        check_forecast_args(history, horizon, self.min_history())?;
-        forecast(&self.params, history, horizon, Form::Naive, self.name())
-    }
-    fn min_history(&self) -> usize {
-        2
-    }
-}
+kf_predictor!(NaiveKf, "naive-kf", |_: &KfDynamicParams| Form::Naive);
