@@ -46,7 +46,21 @@ pub(crate) fn activate(a: Activation, x: Tensor<2>) -> Tensor<2> {
     }
 }
 
-fn check_sizes(name: &'static str, sizes: &[usize], need_one: bool) -> Result<()> {
+/// The widest layer a network may have (a saved model asking for more is refused before
+/// anything is allocated).
+pub const MAX_LAYER_WIDTH: usize = 4096;
+/// The most layers of one kind (recurrent, fully connected) a network may have.
+pub const MAX_LAYERS: usize = 16;
+
+pub(crate) fn check_sizes(name: &'static str, sizes: &[usize], need_one: bool) -> Result<()> {
+    if sizes.len() > MAX_LAYERS || sizes.iter().any(|&w| w > MAX_LAYER_WIDTH) {
+        return Err(NeuralError::InvalidConfig {
+            name,
+            reason: format!(
+                "at most {MAX_LAYERS} layers of at most {MAX_LAYER_WIDTH} units (got {sizes:?})"
+            ),
+        });
+    }
     if need_one && sizes.is_empty() {
         return Err(NeuralError::InvalidConfig {
             name,

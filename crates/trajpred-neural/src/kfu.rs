@@ -44,6 +44,9 @@ pub fn kalman_update(
     (posterior, p_post)
 }
 
+/// The longest unrolled sequence ([`KfuConfig::seq_len`]).
+pub const MAX_SEQ_LEN: usize = 100_000;
+
 /// Architecture and filter settings of [`KfuLstmNet`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct KfuConfig {
@@ -94,12 +97,8 @@ impl KfuConfig {
                 reason: reason.to_string(),
             })
         };
-        if self.layers.is_empty() || self.layers.contains(&0) {
-            return bad("layers", "needs at least one layer, each of size >= 1");
-        }
-        if self.fc.contains(&0) {
-            return bad("fc", "layer sizes must be at least 1");
-        }
+        crate::arch::check_sizes("layers", &self.layers, true)?;
+        crate::arch::check_sizes("fc", &self.fc, false)?;
         if !(self.init_log_q.is_finite() && self.init_log_r.is_finite()) {
             return bad("init_log_q/init_log_r", "must be finite");
         }
@@ -109,8 +108,8 @@ impl KfuConfig {
         if !(self.noise_learning_rate.is_finite() && self.noise_learning_rate >= 0.0) {
             return bad("noise_learning_rate", "must be finite and non-negative");
         }
-        if self.seq_len < 3 {
-            return bad("seq_len", "must be at least 3");
+        if !(3..=MAX_SEQ_LEN).contains(&self.seq_len) {
+            return bad("seq_len", "must lie in 3..=100000");
         }
         if self.stride == 0 {
             return bad("stride", "must be at least 1");
@@ -726,8 +725,20 @@ impl KfuLstmNet {
     /// Loads a model saved by [`KfuLstmNet::save`].
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let (header, mut records) = persist::read(path)?;
-        let h: KfuHeader = persist::from_json(path, &header)?;
+        let (header, records) = persist::read(path)?;
+        Self::from_parts(path, &header, records)
+    }
+
+    /// [`KfuLstmNet::load`] from the bytes of a model file; errors name the source `<bytes>`.
+    pub fn load_bytes(bytes: &[u8]) -> Result<Self> {
+        let path = Path::new("<bytes>");
+        let (header, records) = persist::parse(path, bytes)?;
+        Self::from_parts(path, &header, records)
+    }
+
+    fn from_parts(path: &Path, header: &str, mut records: Vec<Vec<u8>>) -> Result<Self> {
+        let h: KfuHeader = persist::from_json(path, header)?;
+        persist::check_header(path, h.dim, &h.scaler)?;
         if h.kind != NAME || records.len() != 1 {
             return Err(NeuralError::Persistence {
                 path: path.display().to_string(),

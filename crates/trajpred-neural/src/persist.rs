@@ -5,6 +5,7 @@
 //! followed by that many bytes: first the JSON header, then one record per network.
 
 use crate::error::{NeuralError, Result};
+use crate::train::Standardizer;
 use burn::module::Module;
 use burn::store::ModuleRecord;
 use burn::tensor::Bytes;
@@ -35,12 +36,18 @@ pub(crate) fn write<N: Module>(path: &Path, header: &str, nets: &[N]) -> Result<
             .map_err(|e| perr(path, format!("{e:?}")))?;
         push(&bytes[..]);
     }
-    std::fs::write(path, out).map_err(|e| perr(path, e))
+    // whole or not at all: a killed save leaves the previous model file
+    trajpred_core::io::write_atomic(path, &out).map_err(|e| perr(path, e))
 }
 
 /// Reads a file written by [`write`]: the header and the raw records.
 pub(crate) fn read(path: &Path) -> Result<(String, Vec<Vec<u8>>)> {
     let data = std::fs::read(path).map_err(|e| perr(path, e))?;
+    parse(path, &data)
+}
+
+/// Splits the bytes of a model file (named `path` in errors) into header and records.
+pub(crate) fn parse(path: &Path, data: &[u8]) -> Result<(String, Vec<Vec<u8>>)> {
     let rest = data
         .strip_prefix(MAGIC)
         .ok_or_else(|| perr(path, "not a trajpred-neural model file"))?;
@@ -74,6 +81,37 @@ pub(crate) fn load_into<N: Module>(path: &Path, net: N, bytes: Vec<u8>) -> Resul
         .map_err(|e| perr(path, format!("{e:?}")))?;
     net.try_load_record(record)
         .map_err(|e| perr(path, format!("{e:?}")))
+}
+
+/// Checks what a header says about the data before any network is built from it: the
+/// number of axes (1 to [`trajpred_core::MAX_AXES`]) and a standardisation of that many
+/// axes with finite means and finite positive deviations.
+pub(crate) fn check_header(path: &Path, dim: usize, scaler: &Standardizer) -> Result<()> {
+    if dim == 0 || dim > trajpred_core::MAX_AXES {
+        return Err(perr(
+            path,
+            format!("{dim} axes (1 to {} expected)", trajpred_core::MAX_AXES),
+        ));
+    }
+    if scaler.mean.len() != dim || scaler.std.len() != dim {
+        return Err(perr(
+            path,
+            format!(
+                "standardisation of {} / {} axes for {dim} axes",
+                scaler.mean.len(),
+                scaler.std.len()
+            ),
+        ));
+    }
+    if !scaler.mean.iter().all(|m| m.is_finite())
+        || !scaler.std.iter().all(|s| s.is_finite() && *s > 0.0)
+    {
+        return Err(perr(
+            path,
+            "standardisation with a non-finite mean or a deviation that is not finite and positive",
+        ));
+    }
+    Ok(())
 }
 
 /// Serialises a header.

@@ -24,6 +24,9 @@ pub type RnnNet = WindowNet<RnnArch>;
 /// Stacked LSTM layers + fully connected layers.
 pub type LstmNet = WindowNet<LstmArch>;
 
+/// The longest input window and trained horizon of a windowed model.
+pub const MAX_WINDOW: usize = 4096;
+
 /// Window length, horizon and axis handling of a windowed model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct WindowConfig {
@@ -36,19 +39,15 @@ pub struct WindowConfig {
 }
 
 impl WindowConfig {
-    /// Checks `m >= 1` and `T >= 1`.
+    /// Checks `1 <= m <= MAX_WINDOW` and `1 <= T <= MAX_WINDOW`.
     pub fn validate(&self) -> Result<()> {
-        if self.window == 0 {
-            return Err(NeuralError::InvalidConfig {
-                name: "window",
-                reason: "must be at least 1".into(),
-            });
-        }
-        if self.horizon == 0 {
-            return Err(NeuralError::InvalidConfig {
-                name: "horizon",
-                reason: "must be at least 1".into(),
-            });
+        for (name, v) in [("window", self.window), ("horizon", self.horizon)] {
+            if !(1..=MAX_WINDOW).contains(&v) {
+                return Err(NeuralError::InvalidConfig {
+                    name,
+                    reason: format!("must lie in 1..={MAX_WINDOW}, got {v}"),
+                });
+            }
         }
         Ok(())
     }
@@ -521,7 +520,20 @@ impl<A: Architecture> WindowNet<A> {
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         let (header, records) = persist::read(path)?;
-        let h: Header<A> = persist::from_json(path, &header)?;
+        Self::from_parts(path, &header, records)
+    }
+
+    /// [`WindowNet::load`] from the bytes of a model file (held in memory, a database...);
+    /// errors name the source `<bytes>`.
+    pub fn load_bytes(bytes: &[u8]) -> Result<Self> {
+        let path = Path::new("<bytes>");
+        let (header, records) = persist::parse(path, bytes)?;
+        Self::from_parts(path, &header, records)
+    }
+
+    fn from_parts(path: &Path, header: &str, records: Vec<Vec<u8>>) -> Result<Self> {
+        let h: Header<A> = persist::from_json(path, header)?;
+        persist::check_header(path, h.dim, &h.scaler)?;
         if h.kind != A::NAME {
             return Err(NeuralError::Persistence {
                 path: path.display().to_string(),
