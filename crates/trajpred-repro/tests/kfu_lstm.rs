@@ -226,9 +226,18 @@ fn fair_tables_are_consistent_and_reproducible() {
                 num(&a, r, "min").expect("min"),
                 num(&a, r, "max").expect("max"),
             );
-            assert!(mean.is_finite() && mean > 0.0, "{target} row {r}: mean {mean}");
-            assert!(lo <= mean && mean <= hi, "{target} row {r}: {lo} {mean} {hi}");
-            assert!(num(&a, r, "sd over seeds").is_some(), "{target} row {r}: sd");
+            assert!(
+                mean.is_finite() && mean > 0.0,
+                "{target} row {r}: mean {mean}"
+            );
+            assert!(
+                lo <= mean && mean <= hi,
+                "{target} row {r}: {lo} {mean} {hi}"
+            );
+            assert!(
+                num(&a, r, "sd over seeds").is_some(),
+                "{target} row {r}: sd"
+            );
             let kfu = a.get(r, "method") == Some(&Value::Text("KFU-LSTM-Net".into()));
             assert_eq!(num(&a, r, "pooled sd with KFU").is_none(), kfu, "row {r}");
         }
