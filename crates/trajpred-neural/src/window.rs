@@ -229,6 +229,45 @@ impl<A: Architecture> WindowNet<A> {
         train: &[Trajectory],
         progress: &mut dyn FnMut(&EpochReport),
     ) -> Result<&[TrainReport]> {
+        self.fit_inner(train, None, progress)
+    }
+
+    /// Trains on the windows of `inputs` with targets taken from `targets` at the same
+    /// indices (same lengths and axes; e.g. noisy inputs and their clean truth): the sample
+    /// of window `i` maps `inputs[i..i + m]` to `targets[i + m..i + m + T]`. Both are
+    /// z-scored with the inputs' mean and standard deviation. With `targets == inputs` this
+    /// is [`WindowNet::fit_with`].
+    pub fn fit_targets(
+        &mut self,
+        inputs: &[Trajectory],
+        targets: &[Trajectory],
+        progress: &mut dyn FnMut(&EpochReport),
+    ) -> Result<&[TrainReport]> {
+        if inputs.len() != targets.len() {
+            return Err(NeuralError::DimensionMismatch {
+                what: "number of target trajectories",
+                expected: inputs.len(),
+                got: targets.len(),
+            });
+        }
+        for (i, t) in inputs.iter().zip(targets) {
+            if i.len() != t.len() || i.dim() != t.dim() {
+                return Err(NeuralError::DimensionMismatch {
+                    what: "target trajectory length x axes",
+                    expected: i.len() * i.dim(),
+                    got: t.len() * t.dim(),
+                });
+            }
+        }
+        self.fit_inner(inputs, Some(targets), progress)
+    }
+
+    fn fit_inner(
+        &mut self,
+        train: &[Trajectory],
+        targets: Option<&[Trajectory]>,
+        progress: &mut dyn FnMut(&EpochReport),
+    ) -> Result<&[TrainReport]> {
         let dim = train
             .first()
             .map(Trajectory::dim)
@@ -265,13 +304,23 @@ impl<A: Architecture> WindowNet<A> {
                     .collect()
             })
             .collect();
+        let zt: Option<Vec<Vec<Vec<f64>>>> = targets.map(|ts| {
+            ts.iter()
+                .map(|t| {
+                    (0..dim)
+                        .map(|k| t.axis(k).iter().map(|&v| scaler.forward(k, v)).collect())
+                        .collect()
+                })
+                .collect()
+        });
         let (f, out) = self.shape(dim);
         let split = self.train.early_stopping.map(|e| e.validation_fraction);
         let mut jobs = Vec::new();
         for net_index in 0..self.n_nets(dim) {
             let mut tr = Samples::new(m, f, out);
             let mut va = Samples::new(m, f, out);
-            for axes in &z {
+            for (j, axes) in z.iter().enumerate() {
+                let tgt = zt.as_ref().and_then(|v| v.get(j)).unwrap_or(axes);
                 let n = axes[0].len();
                 if n < m + h {
                     continue;
@@ -291,12 +340,12 @@ impl<A: Architecture> WindowNet<A> {
                             let a = &axes[net_index];
                             dest.push(
                                 a[i..i + m].iter().copied(),
-                                a[i + m..i + m + h].iter().copied(),
+                                tgt[net_index][i + m..i + m + h].iter().copied(),
                             );
                         }
                         AxisMode::Joint => dest.push(
                             (i..i + m).flat_map(|s| axes.iter().map(move |a| a[s])),
-                            (i + m..i + m + h).flat_map(|s| axes.iter().map(move |a| a[s])),
+                            (i + m..i + m + h).flat_map(|s| tgt.iter().map(move |a| a[s])),
                         ),
                     }
                 }

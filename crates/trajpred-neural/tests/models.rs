@@ -493,3 +493,72 @@ fn per_axis_networks_train_in_parallel_and_reproducibly() {
     let (_, b) = run();
     assert_eq!(a, b);
 }
+
+/// `fit_targets` trains on the targets it is given: with the inputs as targets it is
+/// `fit_with`; with other targets (here the inputs shifted by a constant, so a net that has
+/// learnt them predicts about that constant higher) the forecasts move; mismatched targets
+/// are typed errors.
+#[test]
+fn fit_targets_trains_on_the_given_targets() {
+    let x = curve(80, 0.0);
+    let shifted = Trajectory::uniform(
+        0.0,
+        0.1,
+        (0..3)
+            .map(|k| x.axis(k).iter().map(|v| v + 0.5).collect())
+            .collect(),
+    )
+    .unwrap();
+    let fit = |targets: Option<&Trajectory>| {
+        let mut n = RnnNet::new(
+            RnnArch(small_rec()),
+            layout(AxisMode::Joint),
+            TrainConfig::new(1e-2).with_epochs(30).with_seed(4),
+        )
+        .unwrap();
+        match targets {
+            None => n.fit_with(std::slice::from_ref(&x), &mut |_| {}).unwrap(),
+            Some(t) => n
+                .fit_targets(
+                    std::slice::from_ref(&x),
+                    std::slice::from_ref(t),
+                    &mut |_| {},
+                )
+                .unwrap(),
+        };
+        let w: Vec<Vec<f64>> = x.points().skip(40).take(5).map(|p| p.to_vec()).collect();
+        n.predict_window(&w).unwrap()
+    };
+    let plain = fit(None);
+    assert_eq!(fit(Some(&x)), plain, "targets == inputs is fit_with");
+    let up = fit(Some(&shifted));
+    let lift: f64 = up
+        .iter()
+        .zip(&plain)
+        .flat_map(|(a, b)| a.iter().zip(b).map(|(p, q)| p - q))
+        .sum::<f64>()
+        / 6.0;
+    assert!(
+        (lift - 0.5).abs() < 0.25,
+        "mean lift {lift}, expected about 0.5"
+    );
+    let mut n = RnnNet::new(
+        RnnArch(small_rec()),
+        layout(AxisMode::Joint),
+        TrainConfig::new(1e-2).with_epochs(1),
+    )
+    .unwrap();
+    let short = curve(70, 0.0);
+    assert!(matches!(
+        n.fit_targets(
+            std::slice::from_ref(&x),
+            std::slice::from_ref(&short),
+            &mut |_| {}
+        ),
+        Err(NeuralError::DimensionMismatch { .. })
+    ));
+    assert!(matches!(
+        n.fit_targets(std::slice::from_ref(&x), &[], &mut |_| {}),
+        Err(NeuralError::DimensionMismatch { .. })
+    ));
+}

@@ -201,3 +201,52 @@ fn same_seed_gives_identical_tables() {
         }
     }
 }
+
+fn num(t: &Table, row: usize, col: &str) -> Option<f64> {
+    match t.get(row, col) {
+        Some(Value::Num(x)) => Some(*x),
+        _ => None,
+    }
+}
+
+/// The fair test's two tables: three models per series, at least two seeds (so an sd), the
+/// mean between min and max, a pooled sd on the baseline rows only; the curves' rows of the
+/// two runs are identical (every job is seeded, whichever of the two workers ran it).
+#[test]
+fn fair_tables_are_consistent_and_reproducible() {
+    for target in ["truth", "noisy"] {
+        let file = format!("kfu-lstm/fair_{target}.csv");
+        let a = read_table(&with_data().dir.path().join(&file));
+        let b = read_table(&without_data().dir.path().join(&file));
+        assert_eq!(b.rows.len(), 9, "{target}: 3 curves x 3 models");
+        assert!(a.rows.len() == 9 || a.rows.len() == 12, "{target}: rows");
+        for r in 0..a.rows.len() {
+            let (mean, lo, hi) = (
+                num(&a, r, "mean RMSE 3-D").expect("mean"),
+                num(&a, r, "min").expect("min"),
+                num(&a, r, "max").expect("max"),
+            );
+            assert!(
+                mean.is_finite() && mean > 0.0,
+                "{target} row {r}: mean {mean}"
+            );
+            assert!(
+                lo <= mean && mean <= hi,
+                "{target} row {r}: {lo} {mean} {hi}"
+            );
+            assert!(
+                num(&a, r, "sd over seeds").is_some(),
+                "{target} row {r}: sd"
+            );
+            let kfu = a.get(r, "method") == Some(&Value::Text("KFU-LSTM-Net".into()));
+            assert_eq!(num(&a, r, "pooled sd with KFU").is_none(), kfu, "row {r}");
+        }
+        for (r, (ra, rb)) in a.rows.iter().zip(&b.rows).take(9).enumerate() {
+            for ((va, vb), col) in ra.iter().zip(rb).zip(&a.columns) {
+                if col.name != "grid train s" {
+                    assert_eq!(va, vb, "{target} row {r}, column {}", col.name);
+                }
+            }
+        }
+    }
+}

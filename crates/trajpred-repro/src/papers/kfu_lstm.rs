@@ -35,6 +35,7 @@ use serde::Deserialize;
 use train::{Case, MethodRun, run_once};
 use trajpred_data::synthetic::PatentCurve;
 
+mod fair;
 mod flight;
 pub mod train;
 
@@ -76,6 +77,13 @@ pub(crate) struct Budget {
     kfu_lr: f64,
     /// Repetitions (noise draw and network seed).
     reps: usize,
+    /// The fair test (`fair`): epochs of every model on a curve (other series: scaled by
+    /// the fit part's length), seeds, and the validation grid of hidden sizes and learning
+    /// rates.
+    fair_epochs: usize,
+    fair_seeds: usize,
+    fair_hidden: Vec<usize>,
+    fair_lr: Vec<f64>,
 }
 
 fn mean(v: &[f64]) -> f64 {
@@ -205,6 +213,13 @@ pub fn run(ctx: &Context) -> Result<PaperResult> {
         ));
     }
     bar.finish_and_clear();
+    fair::run(&cases, ctx.seed, &p, &s, &mut out)?;
+    out.var("fair_epochs", s.fair_epochs);
+    out.var("fair_seeds", s.fair_seeds);
+    out.var(
+        "fair_grid",
+        format!("hidden {:?} x lr {:?}", s.fair_hidden, s.fair_lr),
+    );
     let flight = cases.iter().any(|c| c.name == "flight");
     out.var(
         "scope",
