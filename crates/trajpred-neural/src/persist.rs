@@ -6,9 +6,9 @@
 
 use crate::error::{NeuralError, Result};
 use crate::train::Standardizer;
-use burn::module::Module;
+use burn::module::{Module, ModuleVisitor, Param};
 use burn::store::ModuleRecord;
-use burn::tensor::Bytes;
+use burn::tensor::{Bytes, DType, Tensor};
 use std::path::Path;
 
 const MAGIC: &[u8] = b"trajpred-neural 1\n";
@@ -75,12 +75,43 @@ pub(crate) fn parse(path: &Path, data: &[u8]) -> Result<(String, Vec<Vec<u8>>)> 
     Ok((header, chunks))
 }
 
-/// Loads raw record bytes into a freshly built module.
+/// The element type and shape of every float parameter of a module, in visiting order.
+#[derive(Default, PartialEq)]
+struct Shapes(Vec<(DType, Vec<usize>)>);
+
+impl ModuleVisitor for Shapes {
+    fn visit_float<const D: usize>(&mut self, param: &Param<Tensor<D>>) {
+        let t = param.val();
+        self.0.push((t.dtype(), t.dims().to_vec()));
+    }
+}
+
+fn shapes<N: Module>(net: &N) -> Shapes {
+    let mut s = Shapes::default();
+    net.visit(&mut s);
+    s
+}
+
+/// Loads raw record bytes into a freshly built module. The loaded parameters must have the
+/// fresh module's shapes and be `f32`.
 pub(crate) fn load_into<N: Module>(path: &Path, net: N, bytes: Vec<u8>) -> Result<N> {
+    // cast to the network's f32 on load: a record of another element type (a damaged file)
+    // would otherwise be taken as it is and make burn panic (fixtures/fuzz-models)
     let record = ModuleRecord::from_bytes(Bytes::from_bytes_vec(bytes))
+        .map_err(|e| perr(path, format!("{e:?}")))?
+        .cast_to_module_dtype();
+    let expected = shapes(&net);
+    let loaded = net
+        .try_load_record(record)
         .map_err(|e| perr(path, format!("{e:?}")))?;
-    net.try_load_record(record)
-        .map_err(|e| perr(path, format!("{e:?}")))
+    let got = shapes(&loaded);
+    if got != expected || got.0.iter().any(|(dtype, _)| *dtype != DType::F32) {
+        return Err(perr(
+            path,
+            "the weights' element types or shapes do not match the network the header describes",
+        ));
+    }
+    Ok(loaded)
 }
 
 /// Checks what a header says about the data before any network is built from it: the
