@@ -1,6 +1,6 @@
 //! The full LAR path timed with the protocol of `benches/sklearn_lars_path.py`, so that the two
 //! can be compared like for like: the same data (splitmix64 + Box-Muller, see
-//! `benches/lars.rs`), one untimed warm-up run, then `reps` timed runs, and the median,
+//! `benches/common/mod.rs`), one untimed warm-up run, then `reps` timed runs, and the median,
 //! quartiles and extremes of the wall-clock time in milliseconds, and the thread's CPU time
 //! over the timed runs divided by `reps` (on a shared machine it leaves out the time spent
 //! waiting for a core).
@@ -15,39 +15,13 @@
 //! cargo bench -p trajpred-sparse --bench lars_timing [-- --quick]
 //! ```
 #![allow(missing_docs, clippy::print_stdout)]
-use nalgebra::DMatrix;
+mod common;
+use common::data;
 use std::hint::black_box;
 use std::time::Instant;
 use trajpred_sparse::{Gram, Lars, Method};
 
-const GOLDEN: u64 = 0x9E37_79B9_7F4A_7C15;
 const CASES: [(usize, usize); 4] = [(442, 10), (2000, 100), (5000, 500), (200, 1000)];
-
-fn splitmix(k: u64) -> u64 {
-    let mut z = k.wrapping_add(1).wrapping_mul(GOLDEN);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-fn uniform(k: u64) -> f64 {
-    ((splitmix(k) >> 11) as f64 + 0.5) * (1.0 / (1u64 << 53) as f64)
-}
-
-fn normal(k: u64) -> f64 {
-    let (u1, u2) = (uniform(2 * k), uniform(2 * k + 1));
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-}
-
-/// X[i, j] = normal(i p + j); beta_j = normal(n p + j); y = X beta + normal(n p + p + i).
-fn data(n: usize, p: usize) -> (DMatrix<f64>, Vec<f64>) {
-    let x = DMatrix::from_fn(n, p, |i, j| normal((i * p + j) as u64));
-    let beta: Vec<f64> = (0..p).map(|j| normal((n * p + j) as u64)).collect();
-    let y = (0..n)
-        .map(|i| (0..p).map(|j| x[(i, j)] * beta[j]).sum::<f64>() + normal((n * p + p + i) as u64))
-        .collect();
-    (x, y)
-}
 
 /// The repetition counts of the Python script.
 fn reps_for(n: usize, p: usize, quick: bool) -> usize {
