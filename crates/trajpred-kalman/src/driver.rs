@@ -82,7 +82,7 @@ pub fn check_dt<T: RealField + Copy>(dt: T, what: &'static str) -> Result<()> {
 /// The one recursion behind every run of a trajpred filter over a sequence: `step` is called
 /// for each input in order with the output of the previous call (`None` for the first), and
 /// the outputs are collected; the first error stops the run. [`drive`],
-/// [`Filter::filter`](crate::Filter::filter), [`Filter::forecast`](crate::Filter::forecast),
+/// [`Filter::filter`], [`Filter::forecast`],
 /// the IKF, the augmented UKF and the predictor form all run through it.
 ///
 /// ```
