@@ -5,56 +5,34 @@
 use super::{PaperResult, RunInfo};
 use crate::error::{ReproError, Result, io_err};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::path::Path;
 use trajpred::plot::write_chart;
 
-static TEMP_SERIAL: AtomicU64 = AtomicU64::new(0);
-
-/// The temporary file beside `path` that [`write_atomic_with`] writes first: hidden, in the same
-/// folder (so the final rename stays on one file system), unique to this process and call, and
-/// ending in the destination's extension (the plot writer chooses the format from it), e.g.
-/// `.fig1.svg.tmp-4242-7.svg`. `.gitignore` ignores the pattern `.*.tmp-*`.
-fn temp_path(path: &Path) -> Result<PathBuf> {
-    let name = path.file_name().ok_or_else(|| ReproError::Io {
-        path: path.to_path_buf(),
-        source: std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file path"),
-    })?;
-    let ext = path
-        .extension()
-        .map_or_else(|| "tmp".into(), |e| e.to_string_lossy());
-    let serial = TEMP_SERIAL.fetch_add(1, Ordering::Relaxed);
-    Ok(path.with_file_name(format!(
-        ".{}.tmp-{}-{serial}.{ext}",
-        name.to_string_lossy(),
-        std::process::id()
-    )))
-}
-
-/// Writes `path` atomically: `write` is handed a temporary path in the same folder and must
-/// write the whole file there; the temporary file is then flushed to disk and renamed over
-/// `path`. Readers (and a later run) see either the old file or the new one, never a partial
-/// one. When `write`, the flush or the rename fails, the temporary file is removed, `path` keeps
-/// its old content and the error is returned.
+/// Writes `path` atomically through [`trajpred_core::io::write_atomic_with`]: `write` is handed
+/// a temporary path in the same folder (hidden, ending in the destination's extension, which
+/// the plot writer chooses the format from) and must write the whole file there; the file is
+/// then synced and renamed over `path`. Readers (and a later run) see either the old file or the
+/// new one, never a partial one. When `write`, the sync or the rename fails, the temporary file
+/// is removed, `path` keeps its old content and the error is returned.
 pub fn write_atomic_with<F>(path: &Path, write: F) -> Result<()>
 where
     F: FnOnce(&Path) -> Result<()>,
 {
-    let tmp = temp_path(path)?;
-    let outcome = write(&tmp)
-        .and_then(|()| {
-            std::fs::OpenOptions::new()
-                .write(true)
-                .open(&tmp)
-                .and_then(|f| f.sync_all())
-                .map_err(io_err(&tmp))
+    let mut failed: Option<ReproError> = None;
+    let outcome = trajpred_core::io::write_atomic_with(path, |tmp| {
+        write(tmp).map_err(|e| {
+            failed = Some(e);
+            std::io::Error::other("the writer failed")
         })
-        .and_then(|()| std::fs::rename(&tmp, path).map_err(io_err(path)));
-    if outcome.is_err() {
-        // best effort: the temporary file may not exist if `write` failed before creating it
-        let _ = std::fs::remove_file(&tmp);
+    });
+    match (outcome, failed) {
+        (Ok(()), _) => Ok(()),
+        (Err(_), Some(e)) => Err(e),
+        (Err(source), None) => Err(ReproError::Io {
+            path: path.to_path_buf(),
+            source,
+        }),
     }
-    outcome
 }
 
 /// Writes `bytes` to `path` atomically (see [`write_atomic_with`]).
