@@ -2,8 +2,9 @@
 //! with or without autodiff.
 
 use crate::error::{NeuralError, Result};
+use burn::backend::autodiff::checkpoint::strategy::NoCheckpointing;
 use burn::backend::autodiff::grads::Gradients;
-use burn::backend::autodiff::ops::NodeGuard;
+use burn::backend::autodiff::ops::{Backward, NodeGuard, OpsKind};
 use burn::backend::flex::FlexTensor;
 use burn::backend::tensor::FloatTensor;
 use burn::backend::{Autodiff, Flex};
@@ -92,6 +93,43 @@ pub(crate) fn inputs(prims: Vec<Prim>) -> Inputs {
         })
         .unzip();
     Inputs::Ad(flexes, guards)
+}
+
+/// Runs a fused op of `N` inputs: `run` computes the output (`shape`) and the state its
+/// backward needs from the inputs' flex tensors. With plain inputs the output is a plain
+/// tensor; with autodiff inputs it is registered with `op` as its backward step.
+pub(crate) fn apply<Op, const N: usize, const D: usize>(
+    op: Op,
+    prims: Vec<Prim>,
+    shape: &[usize],
+    what: &str,
+    run: impl FnOnce(&[FlexTensor]) -> Result<(Vec<f32>, Op::State)>,
+) -> Result<Tensor<D>>
+where
+    Op: Backward<Flex, N>,
+{
+    match inputs(prims) {
+        Inputs::Plain(t) => {
+            let (out, _) = run(&t)?;
+            Ok(Tensor::from_primitive::<Flex>(flex(out, shape)))
+        }
+        Inputs::Ad(t, guards) => {
+            let (out, state) = run(&t)?;
+            let nodes: [NodeGuard; N] = guards.try_into().map_err(|_| NeuralError::Tensor {
+                reason: format!("{what}: expected {N} inputs"),
+            })?;
+            let out = flex(out, shape);
+            let ad = match op
+                .prepare::<NoCheckpointing>(nodes)
+                .compute_bound()
+                .stateful()
+            {
+                OpsKind::Tracked(prep) => prep.finish(state, out),
+                OpsKind::UnTracked(prep) => prep.finish(out),
+            };
+            Ok(Tensor::from_primitive::<Autodiff<Flex>>(ad))
+        }
+    }
 }
 
 /// Registers `grad` (`shape`) for a parent node if it requires a gradient.

@@ -11,16 +11,15 @@
 //! posterior, of `P` and of every layer's `h` and `c`, and takes the weight gradients as one
 //! matrix product per weight at the end.
 
-use super::bridge::{self, Inputs};
+use super::bridge;
 use super::{Mat, Real, add_column_sums, cell_backward, cell_forward, gemm};
 use crate::config::Activation;
 use crate::error::{NeuralError, Result};
 use burn::backend::Flex;
 use burn::backend::autodiff::checkpoint::base::Checkpointer;
-use burn::backend::autodiff::checkpoint::strategy::NoCheckpointing;
 use burn::backend::autodiff::grads::Gradients;
-use burn::backend::autodiff::ops::{Backward, Ops, OpsKind};
-use burn::backend::{Autodiff, flex::FlexTensor};
+use burn::backend::autodiff::ops::{Backward, Ops};
+use burn::backend::flex::FlexTensor;
 use burn::tensor::Tensor;
 
 /// The network's sizes; the packed parameter vector holds, in this order and each
@@ -652,26 +651,5 @@ pub(crate) fn sequence(
             },
         ))
     };
-    match bridge::inputs(prims) {
-        Inputs::Plain(t) => {
-            let (out, _) = run(&t)?;
-            Ok(Tensor::from_primitive::<Flex>(bridge::flex(out, &shape)))
-        }
-        Inputs::Ad(t, guards) => {
-            let (out, state) = run(&t)?;
-            let nodes: [_; 2] = guards.try_into().map_err(|_| NeuralError::Tensor {
-                reason: "fused KFU: expected two inputs".into(),
-            })?;
-            let out = bridge::flex(out, &shape);
-            let ad = match SequenceBackward
-                .prepare::<NoCheckpointing>(nodes)
-                .compute_bound()
-                .stateful()
-            {
-                OpsKind::Tracked(prep) => prep.finish(state, out),
-                OpsKind::UnTracked(prep) => prep.finish(out),
-            };
-            Ok(Tensor::from_primitive::<Autodiff<Flex>>(ad))
-        }
-    }
+    bridge::apply(SequenceBackward, prims, &shape, "fused KFU", run)
 }

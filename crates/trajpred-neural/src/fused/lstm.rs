@@ -6,15 +6,14 @@
 //! gradients of every step collected in `dA` (`[T B, 4H]`); then `dW_ih = Xᵀ dA`,
 //! `dW_hh = H_{prev}ᵀ dA`, `db = Σ dA`, `dX = dA W_ihᵀ`, one product each.
 
-use super::bridge::{self, Inputs};
+use super::bridge;
 use super::{Mat, Real, add_column_sums, cell_backward, cell_forward, gemm};
 use crate::error::{NeuralError, Result};
 use burn::backend::Flex;
 use burn::backend::autodiff::checkpoint::base::Checkpointer;
-use burn::backend::autodiff::checkpoint::strategy::NoCheckpointing;
 use burn::backend::autodiff::grads::Gradients;
-use burn::backend::autodiff::ops::{Backward, Ops, OpsKind};
-use burn::backend::{Autodiff, flex::FlexTensor};
+use burn::backend::autodiff::ops::{Backward, Ops};
+use burn::backend::flex::FlexTensor;
 use burn::tensor::Tensor;
 
 /// Sizes of a layer run: batch, steps, input features, hidden units.
@@ -354,26 +353,5 @@ pub(crate) fn layer(
             },
         ))
     };
-    match bridge::inputs(prims) {
-        Inputs::Plain(t) => {
-            let (out, _) = run(&t)?;
-            Ok(Tensor::from_primitive::<Flex>(bridge::flex(out, &shape)))
-        }
-        Inputs::Ad(t, guards) => {
-            let (out, state) = run(&t)?;
-            let nodes: [_; 4] = guards.try_into().map_err(|_| NeuralError::Tensor {
-                reason: "fused LSTM: expected four inputs".into(),
-            })?;
-            let out = bridge::flex(out, &shape);
-            let ad = match LayerBackward
-                .prepare::<NoCheckpointing>(nodes)
-                .compute_bound()
-                .stateful()
-            {
-                OpsKind::Tracked(prep) => prep.finish(state, out),
-                OpsKind::UnTracked(prep) => prep.finish(out),
-            };
-            Ok(Tensor::from_primitive::<Autodiff<Flex>>(ad))
-        }
-    }
+    bridge::apply(LayerBackward, prims, &shape, "fused LSTM", run)
 }
