@@ -2,6 +2,9 @@
 
 #[path = "../examples/diabetes_path.rs"]
 mod diabetes_path;
+#[path = "../examples/gsc_forecast.rs"]
+#[allow(dead_code)]
+mod gsc_forecast;
 
 use trajpred_sparse::PathEvent;
 
@@ -26,4 +29,18 @@ fn diabetes_example_gives_the_papers_order_and_draws_the_lasso_path() {
     assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"));
     assert_eq!(text.matches("<polyline").count(), 10);
     std::fs::remove_file(&svg).ok();
+}
+
+#[test]
+fn gsc_example_beats_the_last_value_at_every_step() {
+    let (gsc, last) = gsc_forecast::run().expect("example runs");
+    eprintln!("gsc {gsc:?}\nlast {last:?}");
+    assert_eq!(gsc.len(), gsc_forecast::HORIZONS);
+    for (t, (g, l)) in gsc.iter().zip(&last).enumerate() {
+        assert!(
+            g < &(0.5 * l),
+            "step {}: gsc {g} against last value {l}",
+            t + 1
+        );
+    }
 }
