@@ -304,6 +304,18 @@ pub type PredictionAndUpdate<T, D, M> = (Gaussian<T, D>, Update<T, D, M>);
 /// A prediction `N(x(k+1|k), P(k+1|k))` with the cross-covariance `Cov(x(k), x(k+1))`.
 pub type PredictionWithCross<T, D> = (Gaussian<T, D>, OMatrix<T, D, D>);
 
+/// What [`Smoother::smooth_with_gains`] returns.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RtsSmoothed<T: RealField, D: Dim>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    /// The smoothed states, in time order (the last one is the last filtered state).
+    pub states: Vec<Gaussian<T, D>>,
+    /// The smoother gains `G(k)`, `k = 0 .. N-2`, in time order.
+    pub gains: Vec<OMatrix<T, D, D>>,
+}
+
 /// The Rauch-Tung-Striebel smoother, for any filter that can say how one filtered state maps
 /// to the next prediction (for the KF `F P` and `F P F^T + Q`; for the UKF through sigma
 /// points).
@@ -324,12 +336,21 @@ where
     /// Smooths filtered estimates (e.g. the posteriors of [`Filter::filter`]'s steps, in
     /// time order). Errors with [`KalmanError::Empty`] for no states.
     fn smooth(&self, filtered: &[Gaussian<T, D>]) -> Result<Vec<Gaussian<T, D>>> {
+        self.smooth_with_gains(filtered).map(|s| s.states)
+    }
+
+    /// [`Smoother::smooth`], also returning the smoother gains `G(k) = C(k) P(k+1|k)^-1`
+    /// (`k = 0 .. N-2`), as filterpy's `rts_smoother` returns `K` (filterpy returns `N`
+    /// gains, the last one zero; here there are `N - 1`, none for the last state, which
+    /// the smoother leaves as filtered). Errors with [`KalmanError::Empty`] for no states.
+    fn smooth_with_gains(&self, filtered: &[Gaussian<T, D>]) -> Result<RtsSmoothed<T, D>> {
         if filtered.is_empty() {
             return Err(KalmanError::Empty {
                 what: "filtered states",
             });
         }
         let mut out: Vec<Gaussian<T, D>> = filtered.to_vec();
+        let mut gains = Vec::with_capacity(filtered.len() - 1);
         for k in (0..filtered.len().saturating_sub(1)).rev() {
             let (pred, cross) = self.prediction_with_cross_covariance(&filtered[k])?;
             let factors = ldl(pred.covariance.clone(), "P(k+1|k)")?;
@@ -349,8 +370,10 @@ where
                 mean,
                 covariance: cov,
             };
+            gains.push(gain);
         }
-        Ok(out)
+        gains.reverse();
+        Ok(RtsSmoothed { states: out, gains })
     }
 
     /// Filters and smooths a sequence in one call.

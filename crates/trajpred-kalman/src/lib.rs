@@ -112,8 +112,8 @@ pub mod model;
 pub use alloc::FilterAllocator;
 pub use error::{KalmanError, Result};
 pub use filter::{
-    CovarianceUpdate, Filter, InputChecks, PredictionAndUpdate, PredictionWithCross, Smoother,
-    Step, Update,
+    CovarianceUpdate, Filter, InputChecks, PredictionAndUpdate, PredictionWithCross, RtsSmoothed,
+    Smoother, Step, Update,
 };
 pub use kf::{Ekf, Kf};
 pub use model::{

@@ -157,6 +157,16 @@ fn kf_cv_matches_filterpy_step_by_step_with_rts_and_log_likelihood() {
         );
     }
     assert_eq!(kf.filter_smooth(&x0, &zs).unwrap(), smoothed);
+    // the smoother gains against filterpy's `K` (its last gain is zero: no gain for the
+    // last state, which stays as filtered)
+    let with_gains = kf.smooth_with_gains(&filtered).unwrap();
+    assert_eq!(with_gains.states, smoothed);
+    let sk = fx["smoothed_gain"].as_array().unwrap();
+    assert_eq!(with_gains.gains.len() + 1, sk.len());
+    for (k, g) in with_gains.gains.iter().enumerate() {
+        close(g, &mat(&sk[k], u4, u4), "smoother gain");
+    }
+    assert_eq!(mat(&sk[sk.len() - 1], u4, u4), Matrix4::zeros());
 }
 
 #[test]
