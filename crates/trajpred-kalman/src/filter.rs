@@ -178,6 +178,10 @@ where
     /// same as [`Filter::update`] but without re-validating `prior` (`predict` validated its
     /// input, and its output is symmetric positive semi-definite by construction).
     /// [`Filter::step`] uses it. With any other prior, call [`Filter::update`].
+    ///
+    /// A speed path of the filter driver, hidden from the documented API: users call
+    /// [`Filter::update`] or [`Filter::step`].
+    #[doc(hidden)]
     fn update_predicted(
         &self,
         prior: &Gaussian<T, D>,
@@ -192,6 +196,10 @@ where
     /// outputs are by construction (shapes, finite values and symmetry are still checked).
     /// [`Filter::filter`] and [`Filter::forecast`] use it after their first step, so a batch
     /// validates the user's initial state fully once.
+    ///
+    /// A speed path of the filter driver, hidden from the documented API: users call
+    /// [`Filter::predict`].
+    #[doc(hidden)]
     fn predict_own_output(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
         self.predict(state)
     }

@@ -171,6 +171,10 @@ where
     /// model overriding `propagate_covariance` is checked unless it says otherwise; a model
     /// that returns `true` without mirroring could pass a non-finite upper triangle of the
     /// prediction to the caller without an error.
+    ///
+    /// A speed hint for the filter driver, hidden from the documented API: a model that does
+    /// not know it can ignore it.
+    #[doc(hidden)]
     fn mirrors_covariance(&self) -> bool {
         false
     }
