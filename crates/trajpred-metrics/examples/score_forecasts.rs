@@ -11,7 +11,7 @@
 //! (forecast B). `tests/examples_run.rs` checks the printed figures against those sums.
 #![allow(clippy::print_stdout)]
 
-use nalgebra::{DMatrix, DVector};
+use trajpred_metrics::nalgebra::{DMatrix, DVector};
 use trajpred_metrics::{MetricsError, consistency, hit_rate, nees, per_horizon, rmse};
 
 /// What the example computes.

@@ -2,6 +2,10 @@
 #![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 
+/// The linear algebra this crate takes and returns, re-exported so that a user needs no
+/// separate (and exactly matching) nalgebra dependency.
+pub use nalgebra;
+
 mod consistency;
 mod error;
 mod point;
