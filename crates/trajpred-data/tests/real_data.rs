@@ -7,12 +7,18 @@ use std::path::{Path, PathBuf};
 use trajpred_data::geodesy::Geodetic;
 use trajpred_data::{LoadOptions, Projection, SkipReason, adsb, geolife, tdrive};
 
+#[path = "../../../testing/skip.rs"]
+mod skip;
+
 fn data_dir(sub: &str) -> Option<PathBuf> {
     let p = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data")).join(sub);
     if p.is_dir() {
         Some(p)
     } else {
-        eprintln!("SKIPPED: {} not found; real-data test not run", p.display());
+        skip::skipped(
+            "trajpred-data/tests/real_data.rs",
+            &format!("{} not found; real-data test not run", p.display()),
+        );
         None
     }
 }

@@ -7,6 +7,9 @@ use std::path::{Path, PathBuf};
 use trajpred_repro::report::ColumnKind;
 use trajpred_repro::{Context, Paper, PaperResult, Table, Value, papers, reproduce_into};
 
+#[path = "../../../testing/skip.rs"]
+mod skip;
+
 /// Metres per degree of latitude (a rough conversion; the test reads the fixtures back
 /// through the loader, so it need not match the loader's projection).
 const M_PER_DEG: f64 = 111_320.0;
@@ -265,9 +268,12 @@ fn the_protocol_preset_gives_the_runners_table() {
 fn quick_run_on_the_real_subset() {
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
     if !data.join("geolife").is_dir() || !data.join("tdrive").is_dir() {
-        eprintln!(
-            "skipped: the real data subset is not at {} (see docs/data.md)",
-            data.display()
+        skip::skipped(
+            "trajpred-repro/tests/kf_dynamic.rs",
+            &format!(
+                "the real data subset is not at {} (see docs/data.md)",
+                data.display()
+            ),
         );
         return;
     }

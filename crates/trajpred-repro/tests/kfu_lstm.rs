@@ -18,13 +18,19 @@ struct Run {
     table: Table,
 }
 
+#[path = "../../../testing/skip.rs"]
+mod skip;
+
 fn data_dir() -> Option<PathBuf> {
     let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
     let found = d.join("adsb-traffic").is_dir();
     if !found {
-        eprintln!(
-            "skipped: the real-data parts of this test need ADS-B flights at {} (see docs/data.md)",
-            d.join("adsb-traffic").display()
+        skip::skipped(
+            "trajpred-repro/tests/kfu_lstm.rs",
+            &format!(
+                "the real-data parts need ADS-B flights at {} (see docs/data.md)",
+                d.join("adsb-traffic").display()
+            ),
         );
     }
     found.then_some(d)

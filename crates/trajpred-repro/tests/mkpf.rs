@@ -9,13 +9,19 @@ use trajpred_repro::papers::mkpf::experiment::{
 };
 use trajpred_repro::{Context, Paper, Value, reproduce_into, run_paper};
 
+#[path = "../../../testing/skip.rs"]
+mod skip;
+
 fn data_dir() -> Option<PathBuf> {
     let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
     let found = d.join("adsb-traffic").is_dir();
     if !found {
-        eprintln!(
-            "skipped: the real-data parts of this test need ADS-B flights at {} (see docs/data.md)",
-            d.join("adsb-traffic").display()
+        skip::skipped(
+            "trajpred-repro/tests/mkpf.rs",
+            &format!(
+                "the real-data parts need ADS-B flights at {} (see docs/data.md)",
+                d.join("adsb-traffic").display()
+            ),
         );
     }
     found.then_some(d)
