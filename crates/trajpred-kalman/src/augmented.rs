@@ -109,7 +109,7 @@ impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
     where
         Tr: NoisyTransition<T, D>,
         Ob: NoisyObservation<T, D, M>,
-        DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M>,
+        DefaultAllocator: FilterAllocator<D, M>,
     {
         validate_models(&transition, &observation)?;
         let l = 2 * transition.state_dim() + observation.observation_dim();

@@ -56,6 +56,29 @@ macro_rules! settings {
 settings!(Kf);
 settings!(Ekf);
 
+// The RTS smoother of the linearised filters: the cross-covariance `C = P F^T`, with `F` the
+// transition matrix (KF) or its Jacobian at the filtered mean (EKF).
+macro_rules! smoother {
+    ($filter:ident, $tr:ident, $ob:ident, |$t:ident, $x:ident| $jacobian:expr) => {
+        impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> Smoother<T, D, M> for $filter<Tr, Ob>
+        where
+            Tr: $tr<T, D>,
+            Ob: $ob<T, D, M>,
+            DefaultAllocator: FilterAllocator<D, M>,
+        {
+            fn prediction_with_cross_covariance(
+                &self,
+                filtered: &Gaussian<T, D>,
+            ) -> Result<PredictionWithCross<T, D>> {
+                let pred = self.predict(filtered)?;
+                let ($t, $x) = (&self.transition, &filtered.mean);
+                let f = $jacobian;
+                Ok((pred, &filtered.covariance * f.transpose()))
+            }
+        }
+    };
+}
+
 /// The linear Kalman filter.
 ///
 /// Predict: `x(k|k-1) = F x(k-1|k-1)`, `P(k|k-1) = F P F^T + Q`.
@@ -249,21 +272,12 @@ where
     }
 }
 
-impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> Smoother<T, D, M> for Kf<Tr, Ob>
-where
-    Tr: LinearTransitionModel<T, D>,
-    Ob: LinearObservationModel<T, D, M>,
-    DefaultAllocator: FilterAllocator<D, M>,
-{
-    fn prediction_with_cross_covariance(
-        &self,
-        filtered: &Gaussian<T, D>,
-    ) -> Result<PredictionWithCross<T, D>> {
-        let pred = self.predict(filtered)?;
-        let cross = &filtered.covariance * self.transition.transition_matrix().transpose();
-        Ok((pred, cross))
-    }
-}
+smoother!(
+    Kf,
+    LinearTransitionModel,
+    LinearObservationModel,
+    |tr, _x| { tr.transition_matrix() }
+);
 
 /// The extended Kalman filter: nonlinear transition **and** observation, each linearised at
 /// the current estimate.
@@ -349,18 +363,6 @@ impl<Tr, Ob> Ekf<Tr, Ob> {
     }
 }
 
-impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> Smoother<T, D, M> for Ekf<Tr, Ob>
-where
-    Tr: TransitionJacobian<T, D>,
-    Ob: ObservationJacobian<T, D, M>,
-    DefaultAllocator: FilterAllocator<D, M>,
-{
-    fn prediction_with_cross_covariance(
-        &self,
-        filtered: &Gaussian<T, D>,
-    ) -> Result<PredictionWithCross<T, D>> {
-        let pred = self.predict(filtered)?;
-        let f = self.transition.transition_jacobian(&filtered.mean)?;
-        Ok((pred, &filtered.covariance * f.transpose()))
-    }
-}
+smoother!(Ekf, TransitionJacobian, ObservationJacobian, |tr, x| {
+    tr.transition_jacobian(x)?
+});

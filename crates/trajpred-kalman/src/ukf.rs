@@ -285,7 +285,7 @@ impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
     where
         Tr: Transition<T, D>,
         Ob: Observation<T, D, M>,
-        DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M>,
+        DefaultAllocator: FilterAllocator<D, M>,
     {
         validate_models(&transition, &observation)?;
         let weights = points.weights(transition.state_dim())?;
