@@ -130,13 +130,7 @@ pub fn kinematic<T: RealField + Copy, D: Dim>(
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    check_positive("dt", dt, false)?;
-    check_positive("var", var, true)?;
-    kinematic_with(
-        layout,
-        polynomial_block(dt),
-        white_noise_block(layout.derivatives, dt, var),
-    )
+    kinematic_noise(layout, dt, ("var", var), white_noise_block)
 }
 
 /// The transition block of one axis: `[[1, dt, dt^2/2], [0, 1, dt], [0, 0, 1]]`.
@@ -190,12 +184,33 @@ pub fn kinematic_continuous<T: RealField + Copy, D: Dim>(
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
+    kinematic_noise(
+        layout,
+        dt,
+        ("spectral_density", spectral_density),
+        continuous_noise_block,
+    )
+}
+
+/// The kinematic transition of `layout` for `dt` with the noise block `noise(derivatives,
+/// dt, level)`, after checking `dt > 0` and the named noise level `>= 0`.
+fn kinematic_noise<T, D>(
+    layout: KinematicLayout,
+    dt: f64,
+    (name, level): (&'static str, f64),
+    noise: fn(usize, f64, f64) -> [[f64; 3]; 3],
+) -> Result<LinearTransition<T, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
     check_positive("dt", dt, false)?;
-    check_positive("spectral_density", spectral_density, true)?;
+    check_positive(name, level, true)?;
     kinematic_with(
         layout,
         polynomial_block(dt),
-        continuous_noise_block(layout.derivatives, dt, spectral_density),
+        noise(layout.derivatives, dt, level),
     )
 }
 

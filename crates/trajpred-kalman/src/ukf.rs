@@ -165,6 +165,41 @@ where
     cross: OMatrix<T, D, E>,
 }
 
+/// The unscented transform of `state` through a model's sigma-point `images`, the image
+/// dimension checked (`what`, `dim`), the model's `noise` added to the covariance
+/// (symmetrised): the common core of the UKF's prediction and update.
+#[inline(always)]
+fn noisy_transform<T, D, E, I, R>(
+    w: &SigmaWeights<T>,
+    state: &Gaussian<T, D>,
+    images: I,
+    residual: R,
+    with_cross: bool,
+    noise: &OMatrix<T, E, E>,
+    (what, dim): (&'static str, usize),
+) -> Result<Transformed<T, D, E>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    E: Dim,
+    I: FnOnce(&OVector<T, D>, &OMatrix<T, D, D>) -> Result<SigmaImages<T, D, E>>,
+    R: Fn(&OVector<T, E>, &OVector<T, E>) -> OVector<T, E>,
+    DefaultAllocator: Allocator<D>
+        + Allocator<D, D>
+        + Allocator<E>
+        + Allocator<E, E>
+        + Allocator<E, D>
+        + Allocator<D, E>,
+{
+    let l = w.spread(&state.covariance)?;
+    let images = images(&state.mean, &l)?;
+    let mut t = unscented_transform(&l, &images, w, residual, with_cross)?;
+    check_dim(what, dim, t.mean.nrows())?;
+    t.covariance += noise;
+    symmetrise(&mut t.covariance);
+    Ok(t)
+}
+
 /// The unscented transform with symmetric points, from the images `g(x)`, `g(x +- L_j)`
 /// of the sigma points ([`SigmaImages`]): the mean is computed as
 /// `g(x) + sum_i Wi residual(g(x_i), g(x))` (equal to `sum_i Wm_i g(x_i)` for a linear
@@ -345,19 +380,17 @@ where
         check_dim("observation", m, z.nrows())?;
         check_finite(z, "observation")?;
         let ob = &self.observation;
-        let l = self.weights.spread(&prior.covariance)?;
-        let images = ob.observe_sigma_points(&prior.mean, &l)?;
-        let t = unscented_transform(
-            &l,
-            &images,
+        let t = noisy_transform(
             &self.weights,
+            prior,
+            |x, l| ob.observe_sigma_points(x, l),
             |a, b| ob.observation_residual(a, b),
             true,
+            ob.observation_noise(),
+            ("h(x)", m),
         )?;
-        check_dim("h(x)", m, t.mean.nrows())?;
         let z_hat = ob.normalize_observation(t.mean);
-        let mut s = t.covariance + ob.observation_noise();
-        symmetrise(&mut s);
+        let s = t.covariance;
         let factors = ldl(s.clone(), "S")?;
         let mut kt = t.cross.transpose();
         factors.solve_mut(&mut kt);
@@ -414,18 +447,16 @@ impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
         let n = self.transition.state_dim();
         validate_state(filtered, n, UKF_CHECKS)?;
         let tr = &self.transition;
-        let l = self.weights.spread(&filtered.covariance)?;
-        let images = tr.transition_sigma_points(&filtered.mean, &l)?;
-        let t = unscented_transform(
-            &l,
-            &images,
+        let t = noisy_transform(
             &self.weights,
+            filtered,
+            |x, l| tr.transition_sigma_points(x, l),
             |a, b| tr.state_residual(a, b),
             with_cross,
+            tr.process_noise(),
+            ("f(x)", n),
         )?;
-        check_dim("f(x)", n, t.mean.nrows())?;
-        let mut p = t.covariance + tr.process_noise();
-        symmetrise(&mut p);
+        let p = t.covariance;
         check_finite(&t.mean, "predicted mean")?;
         check_finite(&p, "predicted covariance")?;
         Ok((
