@@ -380,13 +380,16 @@ where
         check_dim("observation", m, z.nrows())?;
         check_finite(z, "observation")?;
         let ob = &self.observation;
+        let images = |x: &OVector<T, D>, l: &OMatrix<T, D, D>| ob.observe_sigma_points(x, l);
+        let residual = |a: &OVector<T, M>, b: &OVector<T, M>| ob.observation_residual(a, b);
+        let noise = ob.observation_noise();
         let t = noisy_transform(
             &self.weights,
             prior,
-            |x, l| ob.observe_sigma_points(x, l),
-            |a, b| ob.observation_residual(a, b),
+            images,
+            residual,
             true,
-            ob.observation_noise(),
+            noise,
             ("h(x)", m),
         )?;
         let z_hat = ob.normalize_observation(t.mean);
