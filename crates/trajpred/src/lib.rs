@@ -30,6 +30,7 @@
 pub mod dataset;
 pub mod harness;
 pub mod plot;
+pub mod params;
 pub mod predictors;
 pub mod protocol;
 pub mod registry;

@@ -340,13 +340,9 @@ fn mean(v: impl IntoIterator<Item = f64>) -> f64 {
     if n == 0 { f64::NAN } else { s / n as f64 }
 }
 
-/// Splits, fits and evaluates `segments` as `protocol` says.
-pub fn run(
-    protocol: &Protocol,
-    segments: &[Segment],
-    progress: &dyn Progress,
-) -> Result<ProtocolRun> {
-    protocol.validate()?;
+/// The (training, test) segments of `protocol`: its split, then its caps. What [`run`] fits
+/// and tests on, and what `trajpred fit` fits on.
+pub fn split(protocol: &Protocol, segments: &[Segment]) -> Result<(Vec<Segment>, Vec<Segment>)> {
     let (mut train, mut test) = harness::split_segments(segments, protocol.split)?;
     if let Some(n) = protocol.max_train {
         train.truncate(n);
@@ -354,6 +350,35 @@ pub fn run(
     if let Some(n) = protocol.max_test {
         test.truncate(n);
     }
+    Ok((train, test))
+}
+
+/// Makes the predictor of a method for [`run_with`], given the training trajectories.
+pub type Fitter<'a> = dyn Fn(&MethodSpec, &[Trajectory]) -> Result<Box<dyn Predictor>> + 'a;
+
+/// Splits, fits and evaluates `segments` as `protocol` says.
+pub fn run(
+    protocol: &Protocol,
+    segments: &[Segment],
+    progress: &dyn Progress,
+) -> Result<ProtocolRun> {
+    run_with(protocol, segments, progress, &|m, train| {
+        let mut p = build(&m.name, &m.options)?;
+        p.fit(train)?;
+        Ok(p)
+    })
+}
+
+/// [`run`] with the predictors made by `fitter` (e.g. loaded from saved parameters instead
+/// of fitted); its time is reported as the fit time.
+pub fn run_with(
+    protocol: &Protocol,
+    segments: &[Segment],
+    progress: &dyn Progress,
+    fitter: &Fitter<'_>,
+) -> Result<ProtocolRun> {
+    protocol.validate()?;
+    let (train, test) = split(protocol, segments)?;
     if test.is_empty() {
         return Err(Error::InvalidParameter {
             name: "segments",
@@ -368,10 +393,9 @@ pub fn run(
     let mut predictors = Vec::with_capacity(protocol.methods.len());
     let mut fit_seconds = Vec::with_capacity(protocol.methods.len());
     for m in &protocol.methods {
-        let mut p = build(&m.name, &m.options)?;
         progress.start(&format!("fit {}", m.name), 1);
         let t0 = Instant::now();
-        p.fit(&train_tr)?;
+        let p = fitter(m, &train_tr)?;
         fit_seconds.push(t0.elapsed().as_secs_f64());
         progress.finish();
         predictors.push(p);
