@@ -82,12 +82,12 @@ pub const MAX_GSC_SIZE: usize = 256;
 #[non_exhaustive]
 pub enum ParamsError {
     /// Reading or writing the file failed.
-    #[error("{file}: {source}")]
+    #[error("{file}: {error}")]
     Io {
         /// The file.
         file: String,
         /// The I/O error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The file is larger than [`MAX_PARAMS_BYTES`].
     #[error("{file}: larger than the limit of {limit} bytes for a parameter file")]
@@ -99,12 +99,12 @@ pub enum ParamsError {
     },
     /// Not JSON, or JSON of the wrong shape (a missing or unknown field, a wrong type); the
     /// message carries serde_json's line and column.
-    #[error("{file}: {source}")]
+    #[error("{file}: {error}")]
     Json {
         /// The file.
         file: String,
         /// serde_json's error (see its `line()` and `column()`).
-        source: serde_json::Error,
+        error: serde_json::Error,
     },
     /// The `format` field is not [`FORMAT`].
     #[error("{file}: not a trajpred parameter file (`format` is {found}, expected \"{FORMAT}\")")]
@@ -187,12 +187,12 @@ pub enum ParamsError {
         reason: String,
     },
     /// Fitting a method (or exporting what it learned) failed.
-    #[error("fitting `{method}`: {source}")]
+    #[error("fitting `{method}`: {error}")]
     Fit {
         /// The method's label.
         method: String,
         /// The method's error.
-        source: Error,
+        error: Error,
     },
 }
 
@@ -294,9 +294,9 @@ fn shown(v: Option<&serde_json::Value>) -> String {
 /// Refuses, before any fitting, a method that cannot save what it learns.
 pub fn check_exportable(methods: &[MethodSpec]) -> Result<(), ParamsError> {
     for m in methods {
-        let p = build(&m.name, &m.options).map_err(|source| ParamsError::Fit {
+        let p = build(&m.name, &m.options).map_err(|error| ParamsError::Fit {
             method: m.label.clone(),
-            source,
+            error,
         })?;
         if let Err(Error::ParamsUnsupported { reason, .. }) = p.fitted_params() {
             return Err(ParamsError::Unsupported {
@@ -318,9 +318,9 @@ pub fn fit(
     segments: &[Segment],
     progress: &dyn Progress,
 ) -> Result<ParamsFile, ParamsError> {
-    let whole = |source| ParamsError::Fit {
+    let whole = |error| ParamsError::Fit {
         method: protocol.name.clone(),
-        source,
+        error,
     };
     protocol.validate().map_err(whole)?;
     check_exportable(&protocol.methods)?;
@@ -328,9 +328,9 @@ pub fn fit(
     let train_tr: Vec<Trajectory> = train.iter().map(|s| s.trajectory.clone()).collect();
     let mut methods = Vec::with_capacity(protocol.methods.len());
     for m in &protocol.methods {
-        let fail = |source| ParamsError::Fit {
+        let fail = |error| ParamsError::Fit {
             method: m.label.clone(),
-            source,
+            error,
         };
         progress.start(&format!("fit {}", m.label), 1);
         let t0 = Instant::now();
@@ -375,9 +375,9 @@ pub fn fit(
 impl ParamsFile {
     /// The file as pretty-printed JSON.
     pub fn to_json(&self) -> Result<Vec<u8>, ParamsError> {
-        serde_json::to_vec_pretty(self).map_err(|source| ParamsError::Json {
+        serde_json::to_vec_pretty(self).map_err(|error| ParamsError::Json {
             file: self.source.clone(),
-            source,
+            error,
         })
     }
 
@@ -385,18 +385,18 @@ impl ParamsFile {
     pub fn save(&self, path: &Path) -> Result<(), ParamsError> {
         let mut bytes = self.to_json()?;
         bytes.push(b'\n');
-        trajpred_core::io::write_atomic(path, &bytes).map_err(|source| ParamsError::Io {
+        trajpred_core::io::write_atomic(path, &bytes).map_err(|error| ParamsError::Io {
             file: path.display().to_string(),
-            source,
+            error,
         })
     }
 
     /// Reads and checks the file at `path` (at most [`MAX_PARAMS_BYTES`]).
     pub fn load(path: &Path) -> Result<Self, ParamsError> {
         let file = path.display().to_string();
-        let io = |source| ParamsError::Io {
+        let io = |error| ParamsError::Io {
             file: file.clone(),
-            source,
+            error,
         };
         let mut bytes = Vec::new();
         std::fs::File::open(path)
@@ -419,9 +419,9 @@ impl ParamsFile {
                 limit: MAX_PARAMS_BYTES,
             });
         }
-        let json = |source| ParamsError::Json {
+        let json = |error| ParamsError::Json {
             file: file.into(),
-            source,
+            error,
         };
         let header: Header = serde_json::from_slice(bytes).map_err(json)?;
         if header.format.as_ref().and_then(|f| f.as_str()) != Some(FORMAT) {

@@ -39,7 +39,7 @@ fn write_tracks(dir: &Path) -> PathBuf {
 }
 
 /// The common options of `fit` and `evaluate`: the same split.
-fn common<'a>(data: &'a str, methods: &'a str) -> Vec<&'a str> {
+fn common<'a>(data: &'a str, methods: &'a str, seed: &'a str) -> Vec<&'a str> {
     vec![
         "--dataset",
         "csv",
@@ -54,7 +54,7 @@ fn common<'a>(data: &'a str, methods: &'a str) -> Vec<&'a str> {
         "--train-fraction",
         "0.5",
         "--seed",
-        "9",
+        seed,
     ]
 }
 
@@ -76,16 +76,16 @@ fn fit_then_evaluate_with_params_gives_the_table_of_evaluate_with_fitting() {
     let data = data.to_str().expect("utf-8");
     let params = dir.path().join("params.json");
     let params_s = params.to_str().expect("utf-8");
-    let methods = "kf-cv,gskf,hmm,poly1";
+    let methods = "kf-cv,gsc,hmm,poly1";
     let mut fit = vec!["fit"];
-    fit.extend(common(data, methods));
+    fit.extend(common(data, methods, "9"));
     fit.extend(["--output", params_s]);
     let summary = ok(trajpred(&fit));
     // one line per method, what it learned
     let lines: Vec<&str> = summary.lines().collect();
     assert_eq!(lines.len(), 4, "{summary}");
     assert!(lines[0].starts_with("kf-cv: q = "), "{summary}");
-    assert!(lines[1].starts_with("gskf: q per axis = ["), "{summary}");
+    assert!(lines[1].starts_with("gsc: fitted (4 training segments"), "{summary}");
     assert!(lines[2].starts_with("hmm: ") && lines[2].contains("motion states"), "{summary}");
     assert!(lines[3].starts_with("poly1: learns nothing (4 training segments"), "{summary}");
     let v: serde_json::Value =
@@ -95,7 +95,7 @@ fn fit_then_evaluate_with_params_gives_the_table_of_evaluate_with_fitting() {
     assert_eq!(v["fitted_on"]["segments"], 8);
 
     let mut eval = vec!["evaluate"];
-    eval.extend(common(data, methods));
+    eval.extend(common(data, methods, "9"));
     eval.extend(["--format", "csv"]);
     let fitted = ok(trajpred(&eval));
     eval.extend(["--params", params_s]);
@@ -108,8 +108,8 @@ fn fit_then_evaluate_with_params_gives_the_table_of_evaluate_with_fitting() {
 
     // another seed splits differently: said, and still evaluated
     let mut other = vec!["evaluate"];
-    other.extend(common(data, methods));
-    other.extend(["--seed", "10", "--params", params_s, "--format", "csv"]);
+    other.extend(common(data, methods, "10"));
+    other.extend(["--params", params_s, "--format", "csv"]);
     let out = trajpred(&other);
     assert!(String::from_utf8_lossy(&out.stderr).contains("note:"), "{out:?}");
     assert!(out.status.success());
@@ -122,11 +122,11 @@ fn fit_then_evaluate_with_params_gives_the_table_of_evaluate_with_fitting() {
     let text = ok(trajpred(&predict));
     assert_eq!(text.lines().count(), 3, "{text}");
     let missing = trajpred(&[
-        "predict", "--method", "gsc", "--dataset", "csv", "--input", data, "--params", params_s,
+        "predict", "--method", "kf-ca", "--dataset", "csv", "--input", data, "--params", params_s,
     ]);
     assert_eq!(missing.status.code(), Some(1));
     let err = String::from_utf8_lossy(&missing.stderr);
-    assert!(err.contains("holds no parameters for method `gsc`"), "{err}");
+    assert!(err.contains("holds no parameters for method `kf-ca`"), "{err}");
 }
 
 #[test]
@@ -138,10 +138,10 @@ fn fit_and_params_errors_are_one_clear_line() {
     let bad = dir.path().join("bad.json");
     std::fs::write(&bad, "{\"format\": \"trajpred-params\", \"version\": 7}").expect("write");
     let mut neural = vec!["fit"];
-    neural.extend(common(data, "kf-cv,lstm"));
+    neural.extend(common(data, "kf-cv,lstm", "9"));
     neural.extend(["--output", out_file.to_str().expect("utf-8")]);
     let mut evaluate_bad = vec!["evaluate"];
-    evaluate_bad.extend(common(data, "kf-cv"));
+    evaluate_bad.extend(common(data, "kf-cv", "9"));
     evaluate_bad.extend(["--params", bad.to_str().expect("utf-8")]);
     for (args, needle) in [
         (neural, "`lstm` cannot save or load fitted parameters"),

@@ -287,7 +287,7 @@ fn bad_files_are_typed_errors() {
     let text = String::from_utf8(good.clone()).expect("utf-8");
     // not JSON: serde_json's line and column are kept
     match ParamsFile::from_slice(&good[..good.len() / 2], "cut.json") {
-        Err(ParamsError::Json { file, source }) => {
+        Err(ParamsError::Json { file, error: source }) => {
             assert_eq!(file, "cut.json");
             assert!(source.line() > 1 && source.column() > 0, "{source}");
         }
