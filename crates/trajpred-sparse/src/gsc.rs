@@ -283,7 +283,10 @@ impl GroupSparseCoder {
                 col: k / horizons,
             });
         }
-        for (what, v) in [("intercepts", b.as_slice()), ("residual variances", &residual_variances)] {
+        for (what, v) in [
+            ("intercepts", b.as_slice()),
+            ("residual variances", &residual_variances),
+        ] {
             if let Some(row) = v.iter().position(|v| !v.is_finite()) {
                 return Err(Error::NonFinite { what, row, col: 0 });
             }

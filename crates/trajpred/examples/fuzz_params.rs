@@ -47,9 +47,17 @@ pub type Outcome = Result<(), &'static str>;
 
 fn curve(i: usize, n: usize) -> Trajectory {
     let f = i as f64;
-    let t: Vec<f64> = (0..n).map(|k| k as f64 + 0.25 * ((k + i) % 3) as f64).collect();
-    let x = t.iter().map(|t| 2.0 * t + 3.0 * (0.2 * t + f).sin()).collect();
-    let y = t.iter().map(|t| 0.5 * t + (0.1 * t * (1.0 + f)).cos()).collect();
+    let t: Vec<f64> = (0..n)
+        .map(|k| k as f64 + 0.25 * ((k + i) % 3) as f64)
+        .collect();
+    let x = t
+        .iter()
+        .map(|t| 2.0 * t + 3.0 * (0.2 * t + f).sin())
+        .collect();
+    let y = t
+        .iter()
+        .map(|t| 0.5 * t + (0.1 * t * (1.0 + f)).cos())
+        .collect();
     Trajectory::from_axes(t, vec![x, y]).unwrap_or_else(|e| panic!("valid curve: {e}"))
 }
 
@@ -202,7 +210,11 @@ pub fn mutate(data: &[u8], rng: &mut impl Rng) -> Vec<u8> {
             // a value replaced by deep nesting
             if let Some(i) = random_where(&d, rng, |b| b == b':') {
                 let depth = rng.random_range(1..5_000usize);
-                let (open, close) = if rng.random() { (b'[', b']') } else { (b'{', b'}') };
+                let (open, close) = if rng.random() {
+                    (b'[', b']')
+                } else {
+                    (b'{', b'}')
+                };
                 let mut nest = vec![open; depth];
                 if open == b'{' {
                     // objects need keys: {"a":{"a":...}}

@@ -29,8 +29,8 @@
 
 pub mod dataset;
 pub mod harness;
-pub mod plot;
 pub mod params;
+pub mod plot;
 pub mod predictors;
 pub mod protocol;
 pub mod registry;

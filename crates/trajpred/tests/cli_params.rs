@@ -85,9 +85,18 @@ fn fit_then_evaluate_with_params_gives_the_table_of_evaluate_with_fitting() {
     let lines: Vec<&str> = summary.lines().collect();
     assert_eq!(lines.len(), 4, "{summary}");
     assert!(lines[0].starts_with("kf-cv: q = "), "{summary}");
-    assert!(lines[1].starts_with("gsc: fitted (4 training segments"), "{summary}");
-    assert!(lines[2].starts_with("hmm: ") && lines[2].contains("motion states"), "{summary}");
-    assert!(lines[3].starts_with("poly1: learns nothing (4 training segments"), "{summary}");
+    assert!(
+        lines[1].starts_with("gsc: fitted (4 training segments"),
+        "{summary}"
+    );
+    assert!(
+        lines[2].starts_with("hmm: ") && lines[2].contains("motion states"),
+        "{summary}"
+    );
+    assert!(
+        lines[3].starts_with("poly1: learns nothing (4 training segments"),
+        "{summary}"
+    );
     let v: serde_json::Value =
         serde_json::from_slice(&std::fs::read(&params).expect("written")).expect("JSON");
     assert_eq!(v["format"], "trajpred-params");
@@ -111,22 +120,44 @@ fn fit_then_evaluate_with_params_gives_the_table_of_evaluate_with_fitting() {
     other.extend(common(data, methods, "10"));
     other.extend(["--params", params_s, "--format", "csv"]);
     let out = trajpred(&other);
-    assert!(String::from_utf8_lossy(&out.stderr).contains("note:"), "{out:?}");
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("note:"),
+        "{out:?}"
+    );
     assert!(out.status.success());
 
     // predict with the saved HMM, and a method the file lacks
     let mut predict = vec![
-        "predict", "--method", "hmm", "--horizon", "2", "--dataset", "csv", "--input", data,
+        "predict",
+        "--method",
+        "hmm",
+        "--horizon",
+        "2",
+        "--dataset",
+        "csv",
+        "--input",
+        data,
     ];
     predict.extend(["--params", params_s]);
     let text = ok(trajpred(&predict));
     assert_eq!(text.lines().count(), 3, "{text}");
     let missing = trajpred(&[
-        "predict", "--method", "kf-ca", "--dataset", "csv", "--input", data, "--params", params_s,
+        "predict",
+        "--method",
+        "kf-ca",
+        "--dataset",
+        "csv",
+        "--input",
+        data,
+        "--params",
+        params_s,
     ]);
     assert_eq!(missing.status.code(), Some(1));
     let err = String::from_utf8_lossy(&missing.stderr);
-    assert!(err.contains("holds no parameters for method `kf-ca`"), "{err}");
+    assert!(
+        err.contains("holds no parameters for method `kf-ca`"),
+        "{err}"
+    );
 }
 
 #[test]

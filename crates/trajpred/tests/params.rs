@@ -34,8 +34,14 @@ fn segment(i: usize) -> Segment {
     let t: Vec<f64> = (0..60)
         .map(|k| k as f64 + 0.3 * ((k * 7 + i) % 5) as f64)
         .collect();
-    let x = t.iter().map(|t| (2.0 + 0.1 * f) * t + 3.0 * (0.2 * t + f).sin()).collect();
-    let y = t.iter().map(|t| 0.5 * t + 2.0 * (0.15 * t + 0.5 * f).cos()).collect();
+    let x = t
+        .iter()
+        .map(|t| (2.0 + 0.1 * f) * t + 3.0 * (0.2 * t + f).sin())
+        .collect();
+    let y = t
+        .iter()
+        .map(|t| 0.5 * t + 2.0 * (0.15 * t + 0.5 * f).cos())
+        .collect();
     Segment {
         group: format!("g{}", i % 4),
         id: i.to_string(),
@@ -93,7 +99,10 @@ fn protocol_of(methods: &[&str]) -> Protocol {
 
 /// The bits of every mean and covariance entry of a forecast.
 fn bits(f: &Forecast) -> Vec<u64> {
-    let mut v: Vec<u64> = f.points().flat_map(|p| p.iter().map(|x| x.to_bits()).collect::<Vec<_>>()).collect();
+    let mut v: Vec<u64> = f
+        .points()
+        .flat_map(|p| p.iter().map(|x| x.to_bits()).collect::<Vec<_>>())
+        .collect();
     for k in 1..=f.horizon() {
         if let Some(c) = f.covariance(k) {
             v.extend(c.iter().map(|x| x.to_bits()));
@@ -154,7 +163,11 @@ fn loaded_parameters_forecast_bit_for_bit_as_the_fitted_methods() {
 fn the_learned_values_are_written_as_exact_strings() {
     let file = fitted_file(&["kf-cv", "hmm", "gskf"]);
     let kf = &file.method("kf-cv").expect("kf-cv").params;
-    let r: f64 = kf["r"].as_str().expect("a string").parse().expect("a number");
+    let r: f64 = kf["r"]
+        .as_str()
+        .expect("a string")
+        .parse()
+        .expect("a number");
     let mut p = build("kf-cv", &options()).expect("build");
     let segs = segments();
     let (train, _) = protocol::split(&protocol_of(&["kf-cv"]), &segs).expect("split");
@@ -164,7 +177,10 @@ fn the_learned_values_are_written_as_exact_strings() {
     assert!(r > 0.0);
     // the HMM's rows are probabilities; the GSKF has one coder per axis, A is T x m
     let hmm = &file.method("hmm").expect("hmm").params;
-    assert_eq!(hmm["transition"].as_array().expect("rows").len(), hmm["centroids"].as_array().expect("rows").len());
+    assert_eq!(
+        hmm["transition"].as_array().expect("rows").len(),
+        hmm["centroids"].as_array().expect("rows").len()
+    );
     let gskf = &file.method("gskf").expect("gskf").params;
     assert_eq!(gskf["axes"].as_array().expect("axes").len(), 2);
     assert_eq!(gskf["axes"][0]["a"].as_array().expect("A").len(), 3);
@@ -181,7 +197,8 @@ fn json_numbers_would_not_round_trip_but_exact_strings_do() {
     let mut changed_by_json = 0;
     for _ in 0..20_000 {
         let x: f64 = rng.random::<f64>() * 10f64.powi(rng.random_range(-30..30));
-        let back: f64 = serde_json::from_str(&serde_json::to_string(&x).expect("json")).expect("json");
+        let back: f64 =
+            serde_json::from_str(&serde_json::to_string(&x).expect("json")).expect("json");
         changed_by_json += usize::from(back.to_bits() != x.to_bits());
         let exact: f64 = format!("{x:?}").parse().expect("number");
         assert_eq!(exact.to_bits(), x.to_bits(), "{x:?}");
@@ -241,38 +258,162 @@ fn invalid_at(r: Result<ParamsFile, ParamsError>) -> (String, String) {
     }
 }
 
+/// An edit of a saved file's JSON.
+type Edit = Box<dyn FnOnce(&mut Value)>;
+
 #[test]
 fn bad_values_are_invalid_errors_naming_the_json_path() {
     // method order in the file: kf-cv, gsc, hmm, poly1
-    let cases: Vec<(Box<dyn FnOnce(&mut Value)>, &str, &str)> = vec![
-        (Box::new(|v| v["methods"][0]["params"]["r"] = json!("NaN")), "methods[0].params.r", "not finite"),
-        (Box::new(|v| v["methods"][0]["params"]["r"] = json!(-1)), "methods[0].params.r", "must be > 0"),
-        (Box::new(|v| v["methods"][0]["params"]["r"] = json!(0)), "methods[0].params.r", "must be > 0"),
-        (Box::new(|v| v["methods"][0]["params"]["spectral_density"] = json!("1e999")), "methods[0].params.spectral_density", "not finite"),
-        (Box::new(|v| v["methods"][0]["params"]["r"] = json!("ten")), "methods[0].params.r", "not a number"),
-        (Box::new(|v| v["methods"][0]["params"]["r"] = json!([1])), "methods[0].params.r", "expected a number"),
-        (Box::new(|v| v["methods"][0]["params"]["extra"] = json!(1)), "methods[0].params", "unknown field `extra`"),
-        (Box::new(|v| { v["methods"][0]["params"].as_object_mut().expect("object").remove("r"); }), "methods[0].params", "missing field `r`"),
+    let cases: Vec<(Edit, &str, &str)> = vec![
+        (
+            Box::new(|v| v["methods"][0]["params"]["r"] = json!("NaN")),
+            "methods[0].params.r",
+            "not finite",
+        ),
+        (
+            Box::new(|v| v["methods"][0]["params"]["r"] = json!(-1)),
+            "methods[0].params.r",
+            "must be > 0",
+        ),
+        (
+            Box::new(|v| v["methods"][0]["params"]["r"] = json!(0)),
+            "methods[0].params.r",
+            "must be > 0",
+        ),
+        (
+            Box::new(|v| v["methods"][0]["params"]["spectral_density"] = json!("1e999")),
+            "methods[0].params.spectral_density",
+            "not finite",
+        ),
+        (
+            Box::new(|v| v["methods"][0]["params"]["r"] = json!("ten")),
+            "methods[0].params.r",
+            "not a number",
+        ),
+        (
+            Box::new(|v| v["methods"][0]["params"]["r"] = json!([1])),
+            "methods[0].params.r",
+            "expected a number",
+        ),
+        (
+            Box::new(|v| v["methods"][0]["params"]["extra"] = json!(1)),
+            "methods[0].params",
+            "unknown field `extra`",
+        ),
+        (
+            Box::new(|v| {
+                v["methods"][0]["params"]
+                    .as_object_mut()
+                    .expect("object")
+                    .remove("r");
+            }),
+            "methods[0].params",
+            "missing field `r`",
+        ),
         // a coefficient matrix of the wrong shape for m = 4, T = 3
-        (Box::new(|v| { v["methods"][1]["params"]["axes"][0]["a"][1].as_array_mut().expect("row").pop(); }), "methods[1].params.axes[0].a[1]", "expected 4 entries, got 3"),
-        (Box::new(|v| { v["methods"][1]["params"]["axes"][1]["b"].as_array_mut().expect("b").push(json!(1)); }), "methods[1].params.axes[1].b", "expected 3 entries, got 4"),
-        (Box::new(|v| v["methods"][1]["params"]["axes"][0]["residual_variances"][2] = json!(-0.5)), "methods[1].params.axes[0].residual_variances[2]", "must be >= 0"),
-        (Box::new(|v| v["methods"][1]["params"]["axes"] = json!([])), "methods[1].params.axes", "expected 1 to 3 entries, got 0"),
-        (Box::new(|v| { let ax = v["methods"][1]["params"]["axes"][0].clone(); v["methods"][1]["params"]["axes"] = json!([ax, ax, ax, ax]); }), "methods[1].params.axes", "expected 1 to 3 entries, got 4"),
+        (
+            Box::new(|v| {
+                v["methods"][1]["params"]["axes"][0]["a"][1]
+                    .as_array_mut()
+                    .expect("row")
+                    .pop();
+            }),
+            "methods[1].params.axes[0].a[1]",
+            "expected 4 entries, got 3",
+        ),
+        (
+            Box::new(|v| {
+                v["methods"][1]["params"]["axes"][1]["b"]
+                    .as_array_mut()
+                    .expect("b")
+                    .push(json!(1));
+            }),
+            "methods[1].params.axes[1].b",
+            "expected 3 entries, got 4",
+        ),
+        (
+            Box::new(|v| {
+                v["methods"][1]["params"]["axes"][0]["residual_variances"][2] = json!(-0.5)
+            }),
+            "methods[1].params.axes[0].residual_variances[2]",
+            "must be >= 0",
+        ),
+        (
+            Box::new(|v| v["methods"][1]["params"]["axes"] = json!([])),
+            "methods[1].params.axes",
+            "expected 1 to 3 entries, got 0",
+        ),
+        (
+            Box::new(|v| {
+                let ax = v["methods"][1]["params"]["axes"][0].clone();
+                v["methods"][1]["params"]["axes"] = json!([ax, ax, ax, ax]);
+            }),
+            "methods[1].params.axes",
+            "expected 1 to 3 entries, got 4",
+        ),
         // HMM: probabilities in [0, 1], rows summing to 1, K x K, positive variance
-        (Box::new(|v| v["methods"][2]["params"]["initial"][0] = json!(1.5)), "methods[2].params.initial[0]", "in [0, 1]"),
-        (Box::new(|v| v["methods"][2]["params"]["transition"][1][0] = json!(0)), "methods[2].params.transition[1]", "sum to 1"),
-        (Box::new(|v| { v["methods"][2]["params"]["transition"].as_array_mut().expect("rows").pop(); }), "methods[2].params.transition", "entries"),
-        (Box::new(|v| v["methods"][2]["params"]["emission_variance"] = json!(0.0)), "methods[2].params.emission_variance", "must be > 0"),
-        (Box::new(|v| v["methods"][2]["params"]["centroids"][0] = json!([1, 2, 3, 4])), "methods[2].params.centroids[0]", "expected 1 to 3 entries, got 4"),
-        (Box::new(|v| v["methods"][2]["params"]["centroids"][1] = json!([1])), "methods[2].params.centroids[1]", "expected 2 entries, got 1"),
+        (
+            Box::new(|v| v["methods"][2]["params"]["initial"][0] = json!(1.5)),
+            "methods[2].params.initial[0]",
+            "in [0, 1]",
+        ),
+        (
+            Box::new(|v| v["methods"][2]["params"]["transition"][1][0] = json!(0)),
+            "methods[2].params.transition[1]",
+            "sum to 1",
+        ),
+        (
+            Box::new(|v| {
+                v["methods"][2]["params"]["transition"]
+                    .as_array_mut()
+                    .expect("rows")
+                    .pop();
+            }),
+            "methods[2].params.transition",
+            "entries",
+        ),
+        (
+            Box::new(|v| v["methods"][2]["params"]["emission_variance"] = json!(0.0)),
+            "methods[2].params.emission_variance",
+            "must be > 0",
+        ),
+        (
+            Box::new(|v| v["methods"][2]["params"]["centroids"][0] = json!([1, 2, 3, 4])),
+            "methods[2].params.centroids[0]",
+            "expected 1 to 3 entries, got 4",
+        ),
+        (
+            Box::new(|v| v["methods"][2]["params"]["centroids"][1] = json!([1])),
+            "methods[2].params.centroids[1]",
+            "expected 2 entries, got 1",
+        ),
         // a method that learns nothing takes null only
-        (Box::new(|v| v["methods"][3]["params"] = json!({"q": 1})), "methods[3].params", "learns nothing"),
+        (
+            Box::new(|v| v["methods"][3]["params"] = json!({"q": 1})),
+            "methods[3].params",
+            "learns nothing",
+        ),
         // options a method refuses; the fit time
-        (Box::new(|v| v["methods"][3]["options"]["poly_points"] = json!(1)), "methods[3].options", "points"),
-        (Box::new(|v| v["methods"][0]["fit_seconds"] = json!(-1.0)), "methods[0].fit_seconds", ">= 0"),
-        (Box::new(|v| v["fitted_on"]["segmentation"]["min_points"] = json!(0)), "fitted_on.segmentation", "min_points"),
-        (Box::new(|v| v["methods"] = json!([])), "methods", "no method"),
+        (
+            Box::new(|v| v["methods"][3]["options"]["poly_points"] = json!(1)),
+            "methods[3].options",
+            "points",
+        ),
+        (
+            Box::new(|v| v["methods"][0]["fit_seconds"] = json!(-1.0)),
+            "methods[0].fit_seconds",
+            ">= 0",
+        ),
+        (
+            Box::new(|v| v["fitted_on"]["segmentation"]["min_points"] = json!(0)),
+            "fitted_on.segmentation",
+            "min_points",
+        ),
+        (
+            Box::new(|v| v["methods"] = json!([])),
+            "methods",
+            "no method",
+        ),
     ];
     for (edit, path, needle) in cases {
         let (p, reason) = invalid_at(load_edited(edit));
@@ -287,7 +428,10 @@ fn bad_files_are_typed_errors() {
     let text = String::from_utf8(good.clone()).expect("utf-8");
     // not JSON: serde_json's line and column are kept
     match ParamsFile::from_slice(&good[..good.len() / 2], "cut.json") {
-        Err(ParamsError::Json { file, error: source }) => {
+        Err(ParamsError::Json {
+            file,
+            error: source,
+        }) => {
             assert_eq!(file, "cut.json");
             assert!(source.line() > 1 && source.column() > 0, "{source}");
         }
@@ -301,41 +445,81 @@ fn bad_files_are_typed_errors() {
     ));
     // an unknown field anywhere in the structure
     let extra = text.replacen("\"fitted_on\": {", "\"fitted_on\": {\"colour\": 1,", 1);
-    assert!(matches!(ParamsFile::from_slice(extra.as_bytes(), "x"), Err(ParamsError::Json { .. })));
+    assert!(matches!(
+        ParamsFile::from_slice(extra.as_bytes(), "x"),
+        Err(ParamsError::Json { .. })
+    ));
     // format, version
     let other = text.replacen("\"trajpred-params\"", "\"something-else\"", 1);
-    assert!(matches!(ParamsFile::from_slice(other.as_bytes(), "x"), Err(ParamsError::Format { found, .. }) if found == "\"something-else\""));
+    assert!(
+        matches!(ParamsFile::from_slice(other.as_bytes(), "x"), Err(ParamsError::Format { found, .. }) if found == "\"something-else\"")
+    );
     let v2 = text.replacen("\"version\": 1", "\"version\": 2", 1);
-    assert!(matches!(ParamsFile::from_slice(v2.as_bytes(), "x"), Err(ParamsError::Version { found, .. }) if found == "2"));
+    assert!(
+        matches!(ParamsFile::from_slice(v2.as_bytes(), "x"), Err(ParamsError::Version { found, .. }) if found == "2")
+    );
     let no_version = text.replacen("\"version\": 1,", "", 1);
-    assert!(matches!(ParamsFile::from_slice(no_version.as_bytes(), "x"), Err(ParamsError::Version { found, .. }) if found == "missing"));
+    assert!(
+        matches!(ParamsFile::from_slice(no_version.as_bytes(), "x"), Err(ParamsError::Version { found, .. }) if found == "missing")
+    );
     // unknown, duplicated and neural methods
     let unknown = text.replacen("\"name\": \"poly1\"", "\"name\": \"poly9\"", 1);
-    assert!(matches!(ParamsFile::from_slice(unknown.as_bytes(), "x"), Err(ParamsError::UnknownMethod { path, name, .. }) if path == "methods[1].name" && name == "poly9"));
+    assert!(
+        matches!(ParamsFile::from_slice(unknown.as_bytes(), "x"), Err(ParamsError::UnknownMethod { path, name, .. }) if path == "methods[1].name" && name == "poly9")
+    );
     let twice = text.replacen("\"label\": \"poly1\"", "\"label\": \"kf-cv\"", 1);
-    assert!(matches!(ParamsFile::from_slice(twice.as_bytes(), "x"), Err(ParamsError::DuplicateMethod { path, .. }) if path == "methods[1].label"));
+    assert!(
+        matches!(ParamsFile::from_slice(twice.as_bytes(), "x"), Err(ParamsError::DuplicateMethod { path, .. }) if path == "methods[1].label")
+    );
     #[cfg(feature = "neural")]
     {
         let neural = text.replacen("\"name\": \"poly1\"", "\"name\": \"lstm\"", 1);
-        assert!(matches!(ParamsFile::from_slice(neural.as_bytes(), "x"), Err(ParamsError::Unsupported { method, .. }) if method == "poly1"));
-        let spec = MethodSpec { label: "bp".into(), name: "bp".into(), options: options() };
-        assert!(matches!(params::check_exportable(&[spec]), Err(ParamsError::Unsupported { method, .. }) if method == "bp"));
+        assert!(
+            matches!(ParamsFile::from_slice(neural.as_bytes(), "x"), Err(ParamsError::Unsupported { method, .. }) if method == "poly1")
+        );
+        let spec = MethodSpec {
+            label: "bp".into(),
+            name: "bp".into(),
+            options: options(),
+        };
+        assert!(
+            matches!(params::check_exportable(&[spec]), Err(ParamsError::Unsupported { method, .. }) if method == "bp")
+        );
     }
     // limits: the number of methods, the GSC sizes, the file size
     let mut v: Value = serde_json::from_slice(&good).expect("json");
     let one = v["methods"][1].clone();
-    v["methods"] = Value::Array((0..=MAX_METHODS).map(|i| { let mut m = one.clone(); m["label"] = json!(format!("m{i}")); m }).collect());
-    assert!(matches!(ParamsFile::from_slice(&serde_json::to_vec(&v).expect("json"), "x"), Err(ParamsError::Limit { path, got, .. }) if path == "methods" && got == MAX_METHODS + 1));
+    v["methods"] = Value::Array(
+        (0..=MAX_METHODS)
+            .map(|i| {
+                let mut m = one.clone();
+                m["label"] = json!(format!("m{i}"));
+                m
+            })
+            .collect(),
+    );
+    assert!(
+        matches!(ParamsFile::from_slice(&serde_json::to_vec(&v).expect("json"), "x"), Err(ParamsError::Limit { path, got, .. }) if path == "methods" && got == MAX_METHODS + 1)
+    );
     let mut v: Value = serde_json::from_slice(&good).expect("json");
     v["methods"][1]["options"]["horizons"] = json!(MAX_GSC_SIZE + 1);
-    assert!(matches!(ParamsFile::from_slice(&serde_json::to_vec(&v).expect("json"), "x"), Err(ParamsError::Limit { path, .. }) if path == "methods[1].options.horizons"));
+    assert!(
+        matches!(ParamsFile::from_slice(&serde_json::to_vec(&v).expect("json"), "x"), Err(ParamsError::Limit { path, .. }) if path == "methods[1].options.horizons")
+    );
     let mut huge = good.clone();
     huge.resize(MAX_PARAMS_BYTES as usize + 1, b' ');
-    assert!(matches!(ParamsFile::from_slice(&huge, "x"), Err(ParamsError::TooLarge { .. })));
+    assert!(matches!(
+        ParamsFile::from_slice(&huge, "x"),
+        Err(ParamsError::TooLarge { .. })
+    ));
     // a file that is not there; a method the file lacks
-    assert!(matches!(ParamsFile::load("/no/such/params.json".as_ref()), Err(ParamsError::Io { file, .. }) if file == "/no/such/params.json"));
+    assert!(
+        matches!(ParamsFile::load("/no/such/params.json".as_ref()), Err(ParamsError::Io { file, .. }) if file == "/no/such/params.json")
+    );
     let loaded = ParamsFile::from_slice(&good, "good.json").expect("loads");
-    assert!(matches!(loaded.predictor("gsc"), Err(ParamsError::Missing { method, available, .. }) if method == "gsc" && available == "kf-cv, poly1"));
+    assert!(
+        matches!(loaded.predictor("gsc"), Err(ParamsError::Missing { method, available, .. }) if method == "gsc" && available == "kf-cv, poly1")
+    );
 }
 
 #[test]

@@ -97,10 +97,7 @@ impl<'a> At<'a> {
                 return Err(self.error(format!("expected {n} entries, got {}", arr.len())));
             }
             None if arr.is_empty() || arr.len() > max => {
-                return Err(self.error(format!(
-                    "expected 1 to {max} entries, got {}",
-                    arr.len()
-                )));
+                return Err(self.error(format!("expected 1 to {max} entries, got {}", arr.len())));
             }
             _ => {}
         }

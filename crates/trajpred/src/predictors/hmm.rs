@@ -87,8 +87,8 @@ fn probabilities(at: &At, k: usize) -> Result<Vec<f64>> {
 impl HmmModel {
     fn to_json(&self) -> serde_json::Value {
         serde_json::json!({
-            "centroids": self.centroids.iter().map(|c| exact_vec(c)).collect::<Vec<_>>(),
-            "transition": self.transition.iter().map(|r| exact_vec(r)).collect::<Vec<_>>(),
+            "centroids": self.centroids.iter().map(exact_vec).collect::<Vec<_>>(),
+            "transition": self.transition.iter().map(exact_vec).collect::<Vec<_>>(),
             "initial": exact_vec(&self.initial),
             "emission_variance": exact(self.emission_variance),
         })

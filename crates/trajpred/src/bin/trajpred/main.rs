@@ -535,7 +535,16 @@ fn run(cli: Cli) -> Result<()> {
                         stride,
                         max_origins,
                         threshold,
-                        ..custom_protocol(ds, &names, &opts, &segment, history, horizon, max_units, split.of(train_fraction, seed))
+                        ..custom_protocol(
+                            ds,
+                            &names,
+                            &opts,
+                            &segment,
+                            history,
+                            horizon,
+                            max_units,
+                            split.of(train_fraction, seed),
+                        )
                     }
                 }
             };
@@ -552,7 +561,10 @@ fn run(cli: Cli) -> Result<()> {
                     file.predictor(&m.label)?;
                 }
                 for d in file.differences(&p) {
-                    eprintln!("note: {}: {d} (the test part may overlap the training part)", file.source());
+                    eprintln!(
+                        "note: {}: {d} (the test part may overlap the training part)",
+                        file.source()
+                    );
                 }
             }
             let loaded = load_segments(&p, &path, &bars)?;
@@ -653,7 +665,9 @@ fn run(cli: Cli) -> Result<()> {
             }
             let opts = custom_options(kf_q, seed, horizon);
             let split = split.of(train_fraction, seed);
-            let mut p = custom_protocol(ds, &names, &opts, &segment, history, horizon, max_units, split);
+            let mut p = custom_protocol(
+                ds, &names, &opts, &segment, history, horizon, max_units, split,
+            );
             p.load_options = limits.apply(p.load_options);
             // bad settings, misspelt methods and methods that cannot be saved fail before
             // the loading
