@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 use trajpred::dataset::{Dataset, Segment, Segmentation};
 use trajpred::harness::Split;
 use trajpred::params::{self, ParamsError, ParamsFile};
-use trajpred::protocol::{MethodSpec, Protocol, Silent};
+use trajpred::protocol::{self, Silent};
 use trajpred::registry::MethodOptions;
 use trajpred_core::{Predictor, Trajectory};
 
@@ -87,34 +87,12 @@ pub fn seeds() -> Vec<Vec<u8>> {
     ];
     sets.iter()
         .map(|names| {
-            let protocol = Protocol {
-                name: "fuzz".into(),
-                description: String::new(),
-                dataset: Dataset::Csv,
-                load_options: Dataset::Csv.options(),
-                max_units: None,
-                segmentation: Segmentation::default(),
-                split: Split::ByTrajectory {
-                    train_fraction: 0.5,
-                    seed: 1,
-                },
-                max_train: None,
-                max_test: None,
-                histories: vec![10],
-                horizon: 2,
-                stride: 1,
-                max_origins: None,
-                threshold: 25.0,
-                same_origins: false,
-                methods: names
-                    .iter()
-                    .map(|n| MethodSpec {
-                        label: n.to_string(),
-                        name: n.to_string(),
-                        options: options.clone(),
-                    })
-                    .collect(),
+            let split = Split::ByTrajectory {
+                train_fraction: 0.5,
+                seed: 1,
             };
+            let seg = Segmentation::default();
+            let protocol = protocol::custom(Dataset::Csv, names, &options, seg, split, 10, 2);
             params::fit(&protocol, Path::new("fuzz"), &segments, &Silent)
                 .and_then(|f| f.to_json())
                 .unwrap_or_else(|e| panic!("seed file: {e}"))
@@ -151,26 +129,19 @@ pub fn mutate(data: &[u8], rng: &mut impl Rng) -> Vec<u8> {
     if d.is_empty() {
         return d;
     }
+    let (n, i) = (d.len(), rng.random_range(0..d.len()));
     match rng.random_range(0..8u32) {
-        0 => {
-            for _ in 0..rng.random_range(1..8usize) {
-                let i = rng.random_range(0..d.len());
-                d[i] ^= 1 << rng.random_range(0..8u32);
-            }
-        }
-        1 => {
-            let i = rng.random_range(0..d.len());
-            d[i] = rng.random();
-        }
-        2 => d.truncate(rng.random_range(0..d.len())),
+        // up to 8 bits flipped, a byte replaced, a cut
+        0 => (0..rng.random_range(1..9usize))
+            .for_each(|_| d[rng.random_range(0..n)] ^= 1 << rng.random_range(0..8u32)),
+        1 => d[i] = rng.random(),
+        2 => d.truncate(i),
         3 => {
-            let a = rng.random_range(0..d.len());
-            let b = (a + rng.random_range(1..64usize)).min(d.len());
-            let span = d[a..b].to_vec();
-            let at = rng.random_range(0..d.len());
-            for _ in 0..rng.random_range(1..4usize) {
-                d.splice(at..at, span.iter().copied());
-            }
+            // a span of up to 64 bytes repeated 1-3 times somewhere
+            let span = d[i..n.min(i + rng.random_range(1..65usize))].to_vec();
+            let at = rng.random_range(0..n);
+            let copies = span.repeat(rng.random_range(1..4usize));
+            d.splice(at..at, copies);
         }
         4 | 5 => {
             // a number (inside an exact string or bare) replaced by an extreme one
@@ -323,22 +294,16 @@ pub fn fuzz_with(
 
 #[allow(dead_code)]
 fn main() {
-    let mut args = std::env::args().skip(1);
-    let executions = args.next().and_then(|a| a.parse().ok()).unwrap_or(20_000);
-    let seed = args.next().and_then(|a| a.parse().ok()).unwrap_or(1);
+    // arguments: executions (default 20 000), seed (default 1)
+    let arg = |i: usize, default: u64| {
+        std::env::args()
+            .nth(i)
+            .and_then(|a| a.parse().ok())
+            .unwrap_or(default)
+    };
     let start = std::time::Instant::now();
-    let stats = fuzz(&seeds(), executions, seed);
-    eprintln!(
-        "fuzz_params: {} executions in {:.1} s: {} loaded, {} refused with a typed error {:?}, {} panics {:?}",
-        stats.executions,
-        start.elapsed().as_secs_f64(),
-        stats.loaded,
-        stats.refused,
-        stats.by_error,
-        stats.panics,
-        stats.findings
-    );
-    if stats.panics > 0 {
-        std::process::exit(1);
-    }
+    let stats = fuzz(&seeds(), arg(1, 20_000) as usize, arg(2, 1));
+    let secs = start.elapsed().as_secs_f64();
+    eprintln!("fuzz_params: {secs:.1} s: {stats:?}");
+    std::process::exit(i32::from(stats.panics > 0));
 }

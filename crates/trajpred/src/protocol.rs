@@ -78,6 +78,46 @@ pub struct Protocol {
     pub methods: Vec<MethodSpec>,
 }
 
+/// A protocol of one history with every method built under the same options, and the rest as
+/// `trajpred evaluate` has it by default (stride 1, every origin, 25 m, no caps): what the
+/// command line builds when no preset is named (`evaluate` and `fit` alike, so the same
+/// options give the same split).
+pub fn custom(
+    dataset: Dataset,
+    names: &[&str],
+    options: &MethodOptions,
+    segmentation: Segmentation,
+    split: Split,
+    history: usize,
+    horizon: usize,
+) -> Protocol {
+    Protocol {
+        name: "custom".into(),
+        description: "from the command line".into(),
+        dataset,
+        load_options: dataset.options(),
+        max_units: None,
+        segmentation,
+        split,
+        max_train: None,
+        max_test: None,
+        histories: vec![history],
+        horizon,
+        stride: 1,
+        max_origins: None,
+        threshold: 25.0,
+        same_origins: false,
+        methods: names
+            .iter()
+            .map(|n| MethodSpec {
+                label: n.to_string(),
+                name: n.to_string(),
+                options: options.clone(),
+            })
+            .collect(),
+    }
+}
+
 /// The names of the presets, in the order [`presets`] returns them.
 pub const PRESETS: [&str; 2] = ["kf-dynamic-geolife", "kf-dynamic-tdrive"];
 

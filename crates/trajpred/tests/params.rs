@@ -64,36 +64,25 @@ fn options() -> MethodOptions {
 }
 
 fn protocol_of(methods: &[&str]) -> Protocol {
+    let segmentation = Segmentation {
+        min_points: 13,
+        ..Segmentation::default()
+    };
+    let split = Split::ByTrajectory {
+        train_fraction: 0.4,
+        seed: 3,
+    };
     Protocol {
-        name: "custom".into(),
-        description: "test".into(),
-        dataset: Dataset::Csv,
-        load_options: Dataset::Csv.options(),
-        max_units: None,
-        segmentation: Segmentation {
-            min_points: 13,
-            ..Segmentation::default()
-        },
-        split: Split::ByTrajectory {
-            train_fraction: 0.4,
-            seed: 3,
-        },
-        max_train: None,
-        max_test: None,
-        histories: vec![10],
-        horizon: 3,
         stride: 4,
-        max_origins: None,
-        threshold: 25.0,
-        same_origins: false,
-        methods: methods
-            .iter()
-            .map(|n| MethodSpec {
-                label: n.to_string(),
-                name: n.to_string(),
-                options: options(),
-            })
-            .collect(),
+        ..protocol::custom(
+            Dataset::Csv,
+            methods,
+            &options(),
+            segmentation,
+            split,
+            10,
+            3,
+        )
     }
 }
 

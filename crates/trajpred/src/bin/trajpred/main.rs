@@ -15,7 +15,7 @@ use trajpred::dataset::{self, Dataset, Loaded, Segment, Segmentation};
 use trajpred::harness::{MethodReport, Split};
 use trajpred::params::{self, ParamsFile};
 use trajpred::plot::{Chart, Series, write_chart};
-use trajpred::protocol::{self, MethodSpec, Protocol};
+use trajpred::protocol::{self, Protocol};
 use trajpred::registry::{MethodOptions, all_methods, build};
 use trajpred_core::MAX_HORIZON;
 use trajpred_core::{Forecast, Trajectory};
@@ -372,9 +372,7 @@ fn custom_options(kf_q: f64, seed: u64, horizon: usize) -> MethodOptions {
     }
 }
 
-/// The protocol `evaluate` and `fit` build from the command line (without `--protocol`):
-/// one history, every method with the same options. `fit` and `evaluate` given the same
-/// options build the same protocol, hence the same split.
+/// The protocol `evaluate` and `fit` build from the command line (without `--protocol`).
 #[allow(clippy::too_many_arguments)]
 fn custom_protocol(
     ds: Dataset,
@@ -386,30 +384,10 @@ fn custom_protocol(
     max_units: Option<usize>,
     split: Split,
 ) -> Protocol {
+    let segmentation = segment.segmentation(history + horizon);
     Protocol {
-        name: "custom".into(),
-        description: "from the command line".into(),
-        dataset: ds,
-        load_options: ds.options(),
         max_units,
-        segmentation: segment.segmentation(history + horizon),
-        split,
-        max_train: None,
-        max_test: None,
-        histories: vec![history],
-        horizon,
-        stride: 1,
-        max_origins: None,
-        threshold: 25.0,
-        same_origins: false,
-        methods: names
-            .iter()
-            .map(|n| MethodSpec {
-                label: n.to_string(),
-                name: n.to_string(),
-                options: opts.clone(),
-            })
-            .collect(),
+        ..protocol::custom(ds, names, opts, segmentation, split, history, horizon)
     }
 }
 
