@@ -110,6 +110,27 @@ pub enum Error {
         /// The predictor's name.
         method: String,
     },
+    /// A method cannot save what fitting learned (or load it back): the neural methods keep
+    /// their weights in model files of their own.
+    #[error("`{method}` cannot save or load fitted parameters: {reason}")]
+    ParamsUnsupported {
+        /// The predictor's name.
+        method: String,
+        /// Why, and what to use instead.
+        reason: String,
+    },
+    /// Fitted parameters handed to [`Predictor::load_fitted_params`](crate::Predictor::load_fitted_params)
+    /// that the method refuses: `path` is the JSON path of the bad field inside them
+    /// (`axes[0].a[2][1]`; empty for the whole value).
+    #[error("fitted parameters of `{method}` at `{path}`: {reason}")]
+    InvalidFitted {
+        /// The predictor's name.
+        method: String,
+        /// JSON path of the bad field, relative to the parameters.
+        path: String,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// An error raised inside a method's own crate (a filter diverged, a solver failed, ...).
     #[error("{method}: {source}")]
     Method {

@@ -13,5 +13,6 @@ pub use error::{Error, Result};
 pub use gaussian::Gaussian;
 pub use predictor::{
     Forecast, MAX_HORIZON, Predictor, check_forecast_args, check_forecast_args_with_max,
+    load_nothing,
 };
 pub use trajectory::{MAX_AXES, Point, Trajectory};

@@ -186,6 +186,57 @@ pub trait Predictor: Send + Sync {
     fn fitted_summary(&self) -> Option<String> {
         None
     }
+
+    /// What fitting learned, as JSON, to be saved and handed back to
+    /// [`Predictor::load_fitted_params`] of a predictor built with the same options:
+    /// `null` for a method that learns nothing. The contract: after loading, the predictor
+    /// forecasts bit for bit as the fitted one did (so floating-point numbers must survive
+    /// the trip exactly; see `docs/evaluation.md`, "Saved parameters").
+    ///
+    /// The default refuses with [`Error::ParamsUnsupported`]: a method must say what it
+    /// learns (or that it learns nothing) before its parameters can be saved, so a learner
+    /// that forgets is an error, never a file that silently holds nothing.
+    fn fitted_params(&self) -> Result<serde_json::Value> {
+        Err(Error::ParamsUnsupported {
+            method: self.name().to_string(),
+            reason: "the method does not export what fitting learns".into(),
+        })
+    }
+
+    /// Takes back what [`Predictor::fitted_params`] exported, instead of fitting. Strict:
+    /// every value is checked (finite, in range, shapes consistent with the options); a bad
+    /// one is [`Error::InvalidFitted`] naming its JSON path. The default refuses, like
+    /// [`Predictor::fitted_params`].
+    fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
+        let _ = params;
+        Err(Error::ParamsUnsupported {
+            method: self.name().to_string(),
+            reason: "the method does not load fitted parameters".into(),
+        })
+    }
+}
+
+/// [`Predictor::load_fitted_params`] of a method that learns nothing: only `null` is
+/// accepted.
+///
+/// ```
+/// use trajpred_core::{load_nothing, Error};
+/// assert!(load_nothing("poly1", &serde_json::Value::Null).is_ok());
+/// assert!(matches!(
+///     load_nothing("poly1", &serde_json::json!({"q": 1})),
+///     Err(Error::InvalidFitted { .. })
+/// ));
+/// ```
+pub fn load_nothing(method: &str, params: &serde_json::Value) -> Result<()> {
+    if params.is_null() {
+        Ok(())
+    } else {
+        Err(Error::InvalidFitted {
+            method: method.to_string(),
+            path: String::new(),
+            reason: "this method learns nothing when fitted: its parameters must be null".into(),
+        })
+    }
 }
 
 impl<P: Predictor + ?Sized> Predictor for Box<P> {
@@ -206,6 +257,12 @@ impl<P: Predictor + ?Sized> Predictor for Box<P> {
     }
     fn fitted_summary(&self) -> Option<String> {
         (**self).fitted_summary()
+    }
+    fn fitted_params(&self) -> Result<serde_json::Value> {
+        (**self).fitted_params()
+    }
+    fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
+        (**self).load_fitted_params(params)
     }
 }
 

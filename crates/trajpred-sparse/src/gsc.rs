@@ -228,6 +228,84 @@ impl GroupSparseCoder {
         }
     }
 
+    /// A coder from its fitted parts, as [`coefficients`](Self::coefficients),
+    /// [`intercepts`](Self::intercepts) and [`residual_variances`](Self::residual_variances)
+    /// return them (e.g. read back from a saved parameter file): `a` is T x m, `b` and the
+    /// residual variances have length T. It predicts exactly as the coder they came from;
+    /// it has no LARS paths ([`path`](Self::path) is `None`).
+    ///
+    /// Errors: [`Error::InvalidParameter`] for m = 0 or T = 0, [`Error::DimensionMismatch`]
+    /// for inconsistent shapes, [`Error::NonFinite`] for a NaN or infinite value (and a
+    /// negative residual variance is an `InvalidParameter`).
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use trajpred_sparse::GroupSparseCoder;
+    /// let series: Vec<f64> = (0..60).map(|k| (0.3 * k as f64).sin()).collect();
+    /// let gsc = GroupSparseCoder::params(4, 2).fit(&series)?;
+    /// let back = GroupSparseCoder::from_parts(
+    ///     gsc.coefficients().clone(),
+    ///     gsc.intercepts().clone(),
+    ///     gsc.residual_variances().to_vec(),
+    /// )?;
+    /// assert_eq!(back.predict(&series[10..14])?, gsc.predict(&series[10..14])?);
+    /// # Ok::<(), trajpred_sparse::Error>(())
+    /// ```
+    pub fn from_parts(
+        a: DMatrix<f64>,
+        b: DVector<f64>,
+        residual_variances: Vec<f64>,
+    ) -> Result<Self> {
+        let (horizons, m) = a.shape();
+        if m == 0 || horizons == 0 {
+            return Err(Error::InvalidParameter {
+                name: "coefficients",
+                reason: format!("A must be at least 1 x 1, got {horizons} x {m}"),
+            });
+        }
+        for (what, len) in [
+            ("intercepts vs rows of A", b.len()),
+            ("residual variances vs rows of A", residual_variances.len()),
+        ] {
+            if len != horizons {
+                return Err(Error::DimensionMismatch {
+                    what,
+                    expected: horizons,
+                    got: len,
+                });
+            }
+        }
+        if let Some(k) = a.iter().position(|v| !v.is_finite()) {
+            // column-major storage: entry k is (k % T, k / T)
+            return Err(Error::NonFinite {
+                what: "coefficients",
+                row: k % horizons,
+                col: k / horizons,
+            });
+        }
+        for (what, v) in [
+            ("intercepts", b.as_slice()),
+            ("residual variances", &residual_variances),
+        ] {
+            if let Some(row) = v.iter().position(|v| !v.is_finite()) {
+                return Err(Error::NonFinite { what, row, col: 0 });
+            }
+        }
+        if let Some(row) = residual_variances.iter().position(|v| *v < 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "residual_variances",
+                reason: format!("entry {row} is negative: {}", residual_variances[row]),
+            });
+        }
+        Ok(GroupSparseCoder {
+            params: GroupSparseCoder::params(m, horizons),
+            a,
+            b,
+            residual_variances,
+            paths: vec![None; horizons],
+        })
+    }
+
     /// Window length m.
     pub fn window(&self) -> usize {
         self.params.window

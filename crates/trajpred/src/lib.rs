@@ -4,6 +4,7 @@
 
 pub mod dataset;
 pub mod harness;
+pub mod params;
 pub mod plot;
 pub mod predictors;
 pub mod protocol;

@@ -78,6 +78,46 @@ pub struct Protocol {
     pub methods: Vec<MethodSpec>,
 }
 
+/// A protocol of one history with every method built under the same options, and the rest as
+/// `trajpred evaluate` has it by default (stride 1, every origin, 25 m, no caps): what the
+/// command line builds when no preset is named (`evaluate` and `fit` alike, so the same
+/// options give the same split).
+pub fn custom(
+    dataset: Dataset,
+    names: &[&str],
+    options: &MethodOptions,
+    segmentation: Segmentation,
+    split: Split,
+    history: usize,
+    horizon: usize,
+) -> Protocol {
+    Protocol {
+        name: "custom".into(),
+        description: "from the command line".into(),
+        dataset,
+        load_options: dataset.options(),
+        max_units: None,
+        segmentation,
+        split,
+        max_train: None,
+        max_test: None,
+        histories: vec![history],
+        horizon,
+        stride: 1,
+        max_origins: None,
+        threshold: 25.0,
+        same_origins: false,
+        methods: names
+            .iter()
+            .map(|n| MethodSpec {
+                label: n.to_string(),
+                name: n.to_string(),
+                options: options.clone(),
+            })
+            .collect(),
+    }
+}
+
 /// The names of the presets, in the order [`presets`] returns them.
 pub const PRESETS: [&str; 2] = ["kf-dynamic-geolife", "kf-dynamic-tdrive"];
 
@@ -340,13 +380,9 @@ fn mean(v: impl IntoIterator<Item = f64>) -> f64 {
     if n == 0 { f64::NAN } else { s / n as f64 }
 }
 
-/// Splits, fits and evaluates `segments` as `protocol` says.
-pub fn run(
-    protocol: &Protocol,
-    segments: &[Segment],
-    progress: &dyn Progress,
-) -> Result<ProtocolRun> {
-    protocol.validate()?;
+/// The (training, test) segments of `protocol`: its split, then its caps. What [`run`] fits
+/// and tests on, and what `trajpred fit` fits on.
+pub fn split(protocol: &Protocol, segments: &[Segment]) -> Result<(Vec<Segment>, Vec<Segment>)> {
     let (mut train, mut test) = harness::split_segments(segments, protocol.split)?;
     if let Some(n) = protocol.max_train {
         train.truncate(n);
@@ -354,6 +390,35 @@ pub fn run(
     if let Some(n) = protocol.max_test {
         test.truncate(n);
     }
+    Ok((train, test))
+}
+
+/// Makes the predictor of a method for [`run_with`], given the training trajectories.
+pub type Fitter<'a> = dyn Fn(&MethodSpec, &[Trajectory]) -> Result<Box<dyn Predictor>> + 'a;
+
+/// Splits, fits and evaluates `segments` as `protocol` says.
+pub fn run(
+    protocol: &Protocol,
+    segments: &[Segment],
+    progress: &dyn Progress,
+) -> Result<ProtocolRun> {
+    run_with(protocol, segments, progress, &|m, train| {
+        let mut p = build(&m.name, &m.options)?;
+        p.fit(train)?;
+        Ok(p)
+    })
+}
+
+/// [`run`] with the predictors made by `fitter` (e.g. loaded from saved parameters instead
+/// of fitted); its time is reported as the fit time.
+pub fn run_with(
+    protocol: &Protocol,
+    segments: &[Segment],
+    progress: &dyn Progress,
+    fitter: &Fitter<'_>,
+) -> Result<ProtocolRun> {
+    protocol.validate()?;
+    let (train, test) = split(protocol, segments)?;
     if test.is_empty() {
         return Err(Error::InvalidParameter {
             name: "segments",
@@ -368,10 +433,9 @@ pub fn run(
     let mut predictors = Vec::with_capacity(protocol.methods.len());
     let mut fit_seconds = Vec::with_capacity(protocol.methods.len());
     for m in &protocol.methods {
-        let mut p = build(&m.name, &m.options)?;
         progress.start(&format!("fit {}", m.name), 1);
         let t0 = Instant::now();
-        p.fit(&train_tr)?;
+        let p = fitter(m, &train_tr)?;
         fit_seconds.push(t0.elapsed().as_secs_f64());
         progress.finish();
         predictors.push(p);

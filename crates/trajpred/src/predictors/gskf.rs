@@ -11,6 +11,7 @@
 //! `i` is the most recent one observable at time `i`: `V_t = x_i - X_hat^0_t(i - t)`. Nothing
 //! after the origin is used.
 
+use super::fitted::{At, exact, exact_matrix, exact_vec};
 use super::invalid;
 use nalgebra::{DMatrix, DVector, Dyn};
 use serde::{Deserialize, Serialize};
@@ -219,6 +220,42 @@ fn in_sample_error(filter: &AxisFilter, series: &[&[f64]]) -> Result<f64> {
     Ok(if n > 0 { sum / n as f64 } else { f64::INFINITY })
 }
 
+/// The fitted parameters of one axis's coder: `A` (T x m, row by row), `b` and the residual
+/// variances (length T).
+fn coder_json(gsc: &GroupSparseCoder) -> serde_json::Map<String, serde_json::Value> {
+    let mut m = serde_json::Map::new();
+    m.insert("a".into(), exact_matrix(gsc.coefficients()));
+    m.insert("b".into(), exact_vec(gsc.intercepts().iter()));
+    m.insert(
+        "residual_variances".into(),
+        exact_vec(gsc.residual_variances()),
+    );
+    m
+}
+
+/// Reads a coder back from its fields `a`, `b`, `residual_variances`, with the shape the
+/// options give (T x m).
+fn coder_from(params: &GskfParams, a: &At, b: &At, rv: &At) -> Result<GroupSparseCoder> {
+    let t = params.horizons;
+    let a_m = a.matrix(t, params.window)?;
+    let b_v = b.vector(t, At::f64)?;
+    let rv_v = rv.vector(t, |x| x.f64_min(0.0, false))?;
+    GroupSparseCoder::from_parts(a_m, b_v, rv_v.as_slice().to_vec())
+        .map_err(|e| a.error(e.to_string()))
+}
+
+/// The axes of fitted parameters `{"axes": [...]}`, one per axis (1 to 3).
+fn axes_of<'a>(method: &'a str, params: &'a serde_json::Value) -> Result<Vec<At<'a>>> {
+    let [axes] = At::root(method, params).fields(["axes"])?;
+    axes.items(None, trajpred_core::MAX_AXES)
+}
+
+fn not_fitted(method: &str) -> Error {
+    Error::NotFitted {
+        method: method.into(),
+    }
+}
+
 /// Group sparse coding alone (`docs/papers.md` A.3): per axis, `X_hat = A w + b`.
 ///
 /// ```
@@ -340,6 +377,27 @@ impl Predictor for Gsc {
     fn min_history(&self) -> usize {
         self.params.window
     }
+
+    /// `{"axes": [{"a", "b", "residual_variances"}, ...]}`, one coder per axis.
+    fn fitted_params(&self) -> Result<serde_json::Value> {
+        if self.axes.is_empty() {
+            return Err(not_fitted("gsc"));
+        }
+        let axes = self.axes.iter().map(|g| coder_json(g).into()).collect();
+        Ok(serde_json::json!({ "axes": serde_json::Value::Array(axes) }))
+    }
+
+    fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
+        let axes = axes_of("gsc", params)?
+            .iter()
+            .map(|ax| {
+                let [a, b, rv] = ax.fields(["a", "b", "residual_variances"])?;
+                coder_from(&self.params, &a, &b, &rv)
+            })
+            .collect::<Result<_>>()?;
+        self.axes = axes;
+        Ok(())
+    }
 }
 
 /// MSTPM-GSKF (`docs/papers.md` A.4): GSC corrected by the improved one-step-ahead Kalman filter.
@@ -442,5 +500,44 @@ impl Predictor for Gskf {
     fn min_history(&self) -> usize {
         // the residual of horizon T needs the prediction made T steps ago
         self.params.window + self.params.horizons
+    }
+
+    fn fitted_summary(&self) -> Option<String> {
+        (!self.axes.is_empty()).then(|| {
+            let q: Vec<String> = self.axes.iter().map(|a| format!("{:.3e}", a.q)).collect();
+            format!("q per axis = [{}]", q.join(", "))
+        })
+    }
+
+    /// `{"axes": [{"a", "b", "residual_variances", "q"}, ...]}`: per axis the GSC and the
+    /// process noise; `R` and the converged covariances follow from them (recomputed on
+    /// loading, by the same code, so to the same bits).
+    fn fitted_params(&self) -> Result<serde_json::Value> {
+        if self.axes.is_empty() {
+            return Err(not_fitted("gskf"));
+        }
+        let axes = self
+            .axes
+            .iter()
+            .map(|f| {
+                let mut m = coder_json(&f.gsc);
+                m.insert("q".into(), exact(f.q));
+                serde_json::Value::Object(m)
+            })
+            .collect();
+        Ok(serde_json::json!({ "axes": serde_json::Value::Array(axes) }))
+    }
+
+    fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
+        let axes = axes_of("gskf", params)?
+            .iter()
+            .map(|ax| {
+                let [a, b, rv, q] = ax.fields(["a", "b", "residual_variances", "q"])?;
+                let gsc = coder_from(&self.params, &a, &b, &rv)?;
+                AxisFilter::new(gsc, q.f64_min(0.0, false)?).map_err(|e| ax.error(e.to_string()))
+            })
+            .collect::<Result<_>>()?;
+        self.axes = axes;
+        Ok(())
     }
 }

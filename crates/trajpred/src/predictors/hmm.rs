@@ -6,6 +6,7 @@
 //! the state distribution is forward-filtered over the history's displacements, pushed through
 //! the transition matrix step by step, and the expected centroid is added to the last point.
 
+use super::fitted::{At, exact, exact_vec};
 use super::invalid;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -52,6 +53,74 @@ pub struct HmmModel {
     pub initial: Vec<f64>,
     /// Variance of the isotropic Gaussian emission around each centroid.
     pub emission_variance: f64,
+}
+
+/// Most motion states a loaded HMM may have (the transition matrix is K x K, and each
+/// forecast step costs K^2).
+pub const MAX_HMM_STATES: usize = 4096;
+
+/// How far a row of probabilities may sum from 1 (the fitted rows are normalised counts, off
+/// by a few units of rounding).
+const PROBABILITY_SUM_TOLERANCE: f64 = 1e-9;
+
+/// `k` probabilities in [0, 1] summing to 1 within [`PROBABILITY_SUM_TOLERANCE`].
+fn probabilities(at: &At, k: usize) -> Result<Vec<f64>> {
+    let v: Vec<f64> = at
+        .items(Some(k), k)?
+        .iter()
+        .map(|p| {
+            let x = p.f64()?;
+            if (0.0..=1.0).contains(&x) {
+                Ok(x)
+            } else {
+                Err(p.error(format!("a probability must be in [0, 1], got {x}")))
+            }
+        })
+        .collect::<Result<_>>()?;
+    let s: f64 = v.iter().sum();
+    if (s - 1.0).abs() > PROBABILITY_SUM_TOLERANCE {
+        return Err(at.error(format!("probabilities must sum to 1, sum to {s}")));
+    }
+    Ok(v)
+}
+
+impl HmmModel {
+    fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "centroids": self.centroids.iter().map(exact_vec).collect::<Vec<_>>(),
+            "transition": self.transition.iter().map(exact_vec).collect::<Vec<_>>(),
+            "initial": exact_vec(&self.initial),
+            "emission_variance": exact(self.emission_variance),
+        })
+    }
+
+    fn from_json(params: &serde_json::Value) -> Result<Self> {
+        let [c, tr, init, ev] = At::root("hmm", params).fields([
+            "centroids",
+            "transition",
+            "initial",
+            "emission_variance",
+        ])?;
+        let rows = c.items(None, MAX_HMM_STATES)?;
+        let k = rows.len();
+        let dim = rows[0].items(None, trajpred_core::MAX_AXES)?.len();
+        let centroids = rows
+            .iter()
+            .map(|r| r.items(Some(dim), dim)?.iter().map(At::f64).collect())
+            .collect::<Result<_>>()?;
+        let transition = tr
+            .items(Some(k), k)?
+            .iter()
+            .map(|r| probabilities(r, k))
+            .collect::<Result<_>>()?;
+        Ok(HmmModel {
+            dim,
+            centroids,
+            transition,
+            initial: probabilities(&init, k)?,
+            emission_variance: ev.f64_min(0.0, true)?,
+        })
+    }
 }
 
 /// HMM motion-state predictor (`docs/papers.md` B.2). Assumes a uniform sampling step (resample
@@ -349,6 +418,21 @@ impl Predictor for Hmm {
         self.model
             .as_ref()
             .map(|m| format!("{} motion states", m.centroids.len()))
+    }
+
+    /// `{"centroids": K x dim, "transition": K x K, "initial": K, "emission_variance"}`.
+    fn fitted_params(&self) -> Result<serde_json::Value> {
+        self.model
+            .as_ref()
+            .map(HmmModel::to_json)
+            .ok_or_else(|| Error::NotFitted {
+                method: "hmm".into(),
+            })
+    }
+
+    fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
+        self.model = Some(HmmModel::from_json(params)?);
+        Ok(())
     }
 
     fn fit(&mut self, train_set: &[Trajectory]) -> Result<()> {

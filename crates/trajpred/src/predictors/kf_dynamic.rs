@@ -272,6 +272,12 @@ macro_rules! kf_predictor {
             fn fit(&mut self, _train: &[Trajectory]) -> Result<()> {
                 Ok(())
             }
+            fn fitted_params(&self) -> Result<serde_json::Value> {
+                Ok(serde_json::Value::Null)
+            }
+            fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
+                trajpred_core::load_nothing(self.name(), params)
+            }
             fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
                 check_forecast_args(history, horizon, self.min_history())?;
                 let form = $form(&self.params);

@@ -4,6 +4,7 @@
 //! likelihood on the training tracks. Run through the filter driver
 //! ([`trajpred_kalman::driver`]); forecasts at any future times.
 
+use super::fitted::{At, exact};
 use super::{invalid, positions_forecast};
 use nalgebra::{Const, DefaultAllocator, Dim, Dyn, OMatrix, OVector, U1, U2, U3, U4, U6, U9};
 use rayon::prelude::*;
@@ -300,6 +301,31 @@ impl Predictor for KfTime {
                 },
             ));
         }
+        self.params.spectral_density = q;
+        self.params.r = r;
+        Ok(())
+    }
+
+    fn fitted_summary(&self) -> Option<String> {
+        Some(format!(
+            "q = {:.4e}, r = {:.4e}",
+            self.params.spectral_density, self.params.r
+        ))
+    }
+
+    /// The noise `{"spectral_density": q, "r": r}` (fitted, or as given when `fit_noise` is
+    /// off).
+    fn fitted_params(&self) -> Result<serde_json::Value> {
+        Ok(serde_json::json!({
+            "spectral_density": exact(self.params.spectral_density),
+            "r": exact(self.params.r),
+        }))
+    }
+
+    fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
+        let name = self.name().to_string();
+        let [q, r] = At::root(&name, params).fields(["spectral_density", "r"])?;
+        let (q, r) = (q.f64_min(0.0, true)?, r.f64_min(0.0, true)?);
         self.params.spectral_density = q;
         self.params.r = r;
         Ok(())

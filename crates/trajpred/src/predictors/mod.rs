@@ -1,6 +1,7 @@
 //! Every method of the four papers as a [`Predictor`](trajpred_core::Predictor).
 
 mod cv_time;
+mod fitted;
 mod gskf;
 mod hmm;
 mod kf_dynamic;
@@ -10,7 +11,7 @@ mod poly;
 
 pub use cv_time::CvTime;
 pub use gskf::{Gsc, Gskf, GskfParams};
-pub use hmm::{Hmm, HmmParams};
+pub use hmm::{Hmm, HmmParams, MAX_HMM_STATES};
 pub use kf_dynamic::{Continuation, KfDynamic, KfDynamicParams, NaiveKf};
 pub use kf_time::{KfTime, KfTimeParams};
 pub use particle::{ParticleKind, ParticleParams, ParticlePredictor};

@@ -123,6 +123,14 @@ impl Predictor for ParticlePredictor {
         Ok(())
     }
 
+    fn fitted_params(&self) -> Result<serde_json::Value> {
+        Ok(serde_json::Value::Null)
+    }
+
+    fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
+        trajpred_core::load_nothing(self.name(), params)
+    }
+
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
         check_forecast_args(history, horizon, self.min_history())?;
         let dt = step_interval(history, history.len());

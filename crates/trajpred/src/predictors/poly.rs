@@ -87,6 +87,14 @@ impl Predictor for PolyFit {
         Ok(())
     }
 
+    fn fitted_params(&self) -> Result<serde_json::Value> {
+        Ok(serde_json::Value::Null)
+    }
+
+    fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
+        trajpred_core::load_nothing(self.name(), params)
+    }
+
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
         check_forecast_args(history, horizon, self.min_history())?;
         let n = self.params.points;

@@ -13,8 +13,9 @@ use progress::Bars;
 use std::path::PathBuf;
 use trajpred::dataset::{self, Dataset, Loaded, Segment, Segmentation};
 use trajpred::harness::{MethodReport, Split};
+use trajpred::params::{self, ParamsFile};
 use trajpred::plot::{Chart, Series, write_chart};
-use trajpred::protocol::{self, MethodSpec, Protocol};
+use trajpred::protocol::{self, Protocol};
 use trajpred::registry::{MethodOptions, all_methods, build};
 use trajpred_core::MAX_HORIZON;
 use trajpred_core::{Forecast, Trajectory};
@@ -147,6 +148,10 @@ enum Command {
         /// Write to this file instead of standard output.
         #[arg(long)]
         output: Option<PathBuf>,
+        /// Use the method's parameters saved by `trajpred fit` instead of fitting it on the
+        /// track.
+        #[arg(long)]
+        params: Option<PathBuf>,
     },
     /// Evaluate methods on a dataset with a rolling origin, or run a paper's protocol.
     Evaluate {
@@ -209,6 +214,54 @@ enum Command {
         #[arg(long, value_enum, default_value = "markdown")]
         format: Format,
         /// No progress bars (they are off anyway when stderr is not a terminal).
+        #[arg(long)]
+        quiet: bool,
+        /// Load the methods' parameters saved by `trajpred fit` instead of fitting them
+        /// (every method asked for must be in the file).
+        #[arg(long)]
+        params: Option<PathBuf>,
+    },
+    /// Fit methods on the training part of a dataset's split (the part `evaluate` with the
+    /// same options fits on) and save what they learned to a JSON file.
+    Fit {
+        /// geolife, tdrive, adsb or csv.
+        #[arg(long)]
+        dataset: String,
+        /// File or folder to load (a dataset's root folder works).
+        #[arg(long)]
+        path: PathBuf,
+        /// Comma-separated methods.
+        #[arg(long)]
+        methods: String,
+        /// History length (with the horizon, the shortest segment kept, as in `evaluate`).
+        #[arg(long, default_value_t = 20)]
+        history: usize,
+        /// Steps forecast (the multi-step models are fitted for it).
+        #[arg(long, default_value_t = 5)]
+        horizon: usize,
+        #[command(flatten)]
+        segment: SegmentArgs,
+        #[command(flatten)]
+        limits: LimitArgs,
+        /// Read at most this many units (GeoLife users, T-Drive taxis, files).
+        #[arg(long)]
+        max_units: Option<usize>,
+        /// How to split segments into training and test parts.
+        #[arg(long, value_enum, default_value = "by-track")]
+        split: SplitArg,
+        /// Share of segments (or users) fitted on.
+        #[arg(long, default_value_t = 0.3)]
+        train_fraction: f64,
+        /// Seed of the split and of randomised methods.
+        #[arg(long)]
+        seed: Option<u64>,
+        /// `Q = q I` of the Kalman predictors.
+        #[arg(long, default_value_t = 10.0)]
+        kf_q: f64,
+        /// The parameter file to write (JSON).
+        #[arg(long)]
+        output: PathBuf,
+        /// No progress bars.
         #[arg(long)]
         quiet: bool,
     },
@@ -294,6 +347,74 @@ fn last_points(tr: &Trajectory, history: Option<usize>) -> Result<Trajectory> {
     }
 }
 
+impl SplitArg {
+    fn of(self, train_fraction: f64, seed: u64) -> Split {
+        match self {
+            SplitArg::ByTrack => Split::ByTrajectory {
+                train_fraction,
+                seed,
+            },
+            SplitArg::ByUser => Split::ByGroup {
+                train_fraction,
+                seed,
+            },
+        }
+    }
+}
+
+/// The options of the methods `evaluate` and `fit` build from the command line.
+fn custom_options(kf_q: f64, seed: u64, horizon: usize) -> MethodOptions {
+    MethodOptions {
+        kf_q,
+        seed,
+        horizons: MethodOptions::default().horizons.max(horizon),
+        ..Default::default()
+    }
+}
+
+/// The protocol `evaluate` and `fit` build from the command line (without `--protocol`).
+#[allow(clippy::too_many_arguments)]
+fn custom_protocol(
+    ds: Dataset,
+    names: &[&str],
+    opts: &MethodOptions,
+    segment: &SegmentArgs,
+    history: usize,
+    horizon: usize,
+    max_units: Option<usize>,
+    split: Split,
+) -> Protocol {
+    let segmentation = segment.segmentation(history + horizon);
+    Protocol {
+        max_units,
+        ..protocol::custom(ds, names, opts, segmentation, split, history, horizon)
+    }
+}
+
+/// Loads and segments the protocol's data (at least two segments), telling what was read.
+fn load_segments(p: &Protocol, path: &std::path::Path, bars: &Bars) -> Result<Loaded> {
+    let spinner = bars.spinner(format!("loading {}", path.display()));
+    let loaded = dataset::load(
+        p.dataset,
+        path,
+        &p.load_options,
+        &p.segmentation,
+        p.max_units,
+    )
+    .with_context(|| format!("cannot load {}", path.display()))?;
+    spinner.finish_and_clear();
+    eprintln!("{}: {}", path.display(), loaded.summary());
+    if loaded.segments.len() < 2 {
+        bail!(
+            "{}: need at least 2 segments of {} points, found {}",
+            path.display(),
+            p.segmentation.min_points,
+            loaded.segments.len()
+        );
+    }
+    Ok(loaded)
+}
+
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Methods => {
@@ -313,13 +434,21 @@ fn run(cli: Cli) -> Result<()> {
             history,
             format,
             output,
+            params,
         } => {
             // a bad method or horizon fails before the loading
             check_horizon(horizon)?;
             build(&method, &method_options(horizon))?;
+            let saved = match &params {
+                Some(file) => Some(ParamsFile::load(file)?.predictor(&method)?),
+                None => None,
+            };
             let seg = load_one(&input)?;
             let hist = last_points(&seg.trajectory, history)?;
-            let f = forecast_from(&method, &hist, horizon)?;
+            let f = match saved {
+                Some(p) => p.forecast(&hist, horizon)?,
+                None => forecast_from(&method, &hist, horizon)?,
+            };
             match output {
                 Some(path) => {
                     let mut buf = Vec::new();
@@ -350,6 +479,7 @@ fn run(cli: Cli) -> Result<()> {
             quick,
             format,
             quiet,
+            params,
         } => {
             let bars = Bars::new(quiet)?;
             check_horizon(horizon)?;
@@ -369,12 +499,7 @@ fn run(cli: Cli) -> Result<()> {
                         .context("--dataset is needed (or --protocol)")?
                         .parse()?;
                     let seed = seed.unwrap_or(0);
-                    let opts = MethodOptions {
-                        kf_q,
-                        seed,
-                        horizons: MethodOptions::default().horizons.max(horizon),
-                        ..Default::default()
-                    };
+                    let opts = custom_options(kf_q, seed, horizon);
                     let names: Vec<&str> = methods
                         .split(',')
                         .map(str::trim)
@@ -383,40 +508,21 @@ fn run(cli: Cli) -> Result<()> {
                     if names.is_empty() {
                         bail!("--methods names no method");
                     }
-                    let split = match split {
-                        SplitArg::ByTrack => Split::ByTrajectory {
-                            train_fraction,
-                            seed,
-                        },
-                        SplitArg::ByUser => Split::ByGroup {
-                            train_fraction,
-                            seed,
-                        },
-                    };
                     Protocol {
-                        name: "custom".into(),
-                        description: "from the command line".into(),
-                        dataset: ds,
-                        load_options: ds.options(),
-                        max_units,
-                        segmentation: segment.segmentation(history + horizon),
-                        split,
-                        max_train: None,
                         max_test: limit,
-                        histories: vec![history],
-                        horizon,
                         stride,
                         max_origins,
                         threshold,
-                        same_origins: false,
-                        methods: names
-                            .iter()
-                            .map(|n| MethodSpec {
-                                label: n.to_string(),
-                                name: n.to_string(),
-                                options: opts.clone(),
-                            })
-                            .collect(),
+                        ..custom_protocol(
+                            ds,
+                            &names,
+                            &opts,
+                            &segment,
+                            history,
+                            horizon,
+                            max_units,
+                            split.of(train_fraction, seed),
+                        )
                     }
                 }
             };
@@ -426,26 +532,27 @@ fn run(cli: Cli) -> Result<()> {
             for m in &p.methods {
                 build(&m.name, &m.options)?;
             }
-            let spinner = bars.spinner(format!("loading {}", path.display()));
-            let loaded = dataset::load(
-                p.dataset,
-                &path,
-                &p.load_options,
-                &p.segmentation,
-                p.max_units,
-            )
-            .with_context(|| format!("cannot load {}", path.display()))?;
-            spinner.finish_and_clear();
-            eprintln!("{}: {}", path.display(), loaded.summary());
-            if loaded.segments.len() < 2 {
-                bail!(
-                    "{}: need at least 2 segments of {} points, found {}",
-                    path.display(),
-                    p.segmentation.min_points,
-                    loaded.segments.len()
-                );
+            // so do a bad parameter file and a method it lacks
+            let saved = params.as_deref().map(ParamsFile::load).transpose()?;
+            if let Some(file) = &saved {
+                for m in &p.methods {
+                    file.predictor(&m.label)?;
+                }
+                for d in file.differences(&p) {
+                    eprintln!(
+                        "note: {}: {d} (the test part may overlap the training part)",
+                        file.source()
+                    );
+                }
             }
-            let run = protocol::run(&p, &loaded.segments, &bars)?;
+            let loaded = load_segments(&p, &path, &bars)?;
+            let run = match &saved {
+                Some(file) => protocol::run_with(&p, &loaded.segments, &bars, &|m, _| {
+                    file.predictor(&m.label)
+                        .map_err(|e| trajpred_core::Error::method(m.label.clone(), e))
+                })?,
+                None => protocol::run(&p, &loaded.segments, &bars)?,
+            };
             eprintln!(
                 "{}: {} training and {} test segments ({} split)",
                 p.name,
@@ -509,6 +616,57 @@ fn run(cli: Cli) -> Result<()> {
             if !dead.is_empty() {
                 bail!("no forecast was made by {}", dead.join("; "));
             }
+        }
+        Command::Fit {
+            dataset: ds,
+            path,
+            methods,
+            history,
+            horizon,
+            segment,
+            limits,
+            max_units,
+            split,
+            train_fraction,
+            seed,
+            kf_q,
+            output,
+            quiet,
+        } => {
+            let bars = Bars::new(quiet)?;
+            check_horizon(horizon)?;
+            let ds: Dataset = ds.parse()?;
+            let seed = seed.unwrap_or(0);
+            let names: Vec<&str> = methods.split(',').map(str::trim).collect();
+            if names.iter().any(|n| n.is_empty()) {
+                bail!("--methods has an empty name: `{methods}`");
+            }
+            let opts = custom_options(kf_q, seed, horizon);
+            let split = split.of(train_fraction, seed);
+            let mut p = custom_protocol(
+                ds, &names, &opts, &segment, history, horizon, max_units, split,
+            );
+            p.load_options = limits.apply(p.load_options);
+            // bad settings, misspelt methods and methods that cannot be saved fail before
+            // the loading
+            p.validate()?;
+            params::check_exportable(&p.methods)?;
+            let loaded = load_segments(&p, &path, &bars)?;
+            let file = params::fit(&p, &path, &loaded.segments, &bars)?;
+            file.save(&output)?;
+            let on = &file.fitted_on;
+            for m in &file.methods {
+                let what = match (&m.summary, m.params.is_null()) {
+                    (Some(s), _) => s.as_str(),
+                    (None, true) => "learns nothing",
+                    (None, false) => "fitted",
+                };
+                println!(
+                    "{}: {what} ({} training segments, {} points, {:.2} s)",
+                    m.label, on.train_segments, on.train_points, m.fit_seconds
+                );
+            }
+            eprintln!("wrote {}", output.display());
         }
         Command::Plot {
             input,
