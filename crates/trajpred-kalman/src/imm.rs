@@ -45,16 +45,17 @@
 //! Decisions the method leaves open are in `docs/kalman.md` (section "IMM").
 //!
 //! ```
-//! use nalgebra::{DMatrix, Matrix2, Matrix2x5, Matrix5, U2, U5, Vector2, Vector5};
+//! use nalgebra::{DMatrix, Matrix5, U2, U5, Vector2, Vector5};
 //! use trajpred_core::Gaussian;
-//! use trajpred_kalman::imm::{Imm, ImmState, constant_velocity_in_turn_state, coordinated_turn_continuous};
-//! use trajpred_kalman::{Ekf, Filter, Kf, LinearObservation};
+//! use trajpred_kalman::imm::{
+//!     Imm, ImmState, constant_velocity_in_turn_state, coordinated_turn_continuous,
+//!     turn_state_position_observation,
+//! };
+//! use trajpred_kalman::{Ekf, Filter, Kf};
 //!
-//! // state [x, vx, y, vy, omega]; a CV mode and a coordinated-turn mode (EKF), 1 s steps
-//! let mut h = Matrix2x5::zeros();
-//! h[(0, 0)] = 1.0;
-//! h[(1, 2)] = 1.0;
-//! let obs = LinearObservation::<f64, U5, U2>::new(h, Matrix2::identity() * 4.0)?;
+//! // state [x, vx, y, vy, omega]; a CV mode and a coordinated-turn mode (EKF), 1 s steps,
+//! // positions observed with variance 4
+//! let obs = turn_state_position_observation::<f64>(4.0)?;
 //! let cv = Kf::new(constant_velocity_in_turn_state::<f64>(1.0, 0.05)?, obs.clone())?;
 //! let ct = Ekf::new(coordinated_turn_continuous::<f64>(1.0, 0.05, 1e-4)?, obs)?;
 //! let modes: Vec<Box<dyn Filter<f64, U5, U2>>> = vec![Box::new(cv), Box::new(ct)];
@@ -72,11 +73,11 @@
 //! let steps = imm.filter(&ImmState::uniform(start, 2)?, &zs)?;
 //! let last = &steps.last().unwrap().state;
 //! assert!(last.probabilities()[1] > 0.8); // the turn mode explains the track
-//! assert!((last.combined().mean[4] - 0.1).abs() < 0.01); // and its turn rate
+//! assert!((last.combined()?.mean[4] - 0.1).abs() < 0.01); // and its turn rate
 //!
 //! // 5-step forecast with covariance: the mixture's moments at each step
 //! let ahead = imm.forecast(last, 5)?;
-//! assert!(ahead[4].combined().covariance[(0, 0)] > last.combined().covariance[(0, 0)]);
+//! assert!(ahead[4].combined()?.covariance[(0, 0)] > last.combined()?.covariance[(0, 0)]);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
@@ -85,10 +86,13 @@ use crate::driver::{TimeStepFilter, check_dt, scan};
 use crate::error::{KalmanError, Result};
 use crate::filter::Filter;
 use crate::linalg::{check_dim, check_finite, symmetrise};
-use crate::model::LinearTransition;
+use crate::model::{LinearObservation, LinearTransition};
 use crate::motion::{CoordinatedTurn, KinematicLayout, StateOrder, kinematic_continuous};
 use nalgebra::allocator::Allocator;
-use nalgebra::{DMatrix, DefaultAllocator, Dim, Matrix5, OMatrix, OVector, RealField, U4, U5};
+use nalgebra::{
+    DMatrix, DefaultAllocator, Dim, Matrix2, Matrix2x5, Matrix5, OMatrix, OVector, RealField, U2,
+    U4, U5,
+};
 use trajpred_core::Gaussian;
 
 /// How far a row of the transition matrix (or the initial mode probabilities) may sum from 1;
@@ -145,9 +149,13 @@ where
     }
 
     /// The combined estimate: the mean and covariance of the mixture
-    /// `sum_j mu_j N(x_j, P_j)`.
-    pub fn combined(&self) -> Gaussian<T, D> {
-        moments(&self.probabilities, &self.modes)
+    /// `sum_j mu_j N(x_j, P_j)`. Errors with [`KalmanError::NonFinite`] when they overflow
+    /// (modes of finite but huge means far apart).
+    pub fn combined(&self) -> Result<Gaussian<T, D>> {
+        let g = moments(&self.probabilities, &self.modes);
+        check_finite(&g.mean, "IMM combined mean")?;
+        check_finite(&g.covariance, "IMM combined covariance")?;
+        Ok(g)
     }
 }
 
@@ -518,6 +526,23 @@ pub fn coordinated_turn_continuous<T: RealField + Copy>(
     CoordinatedTurn::with_process_noise(dt, q)
 }
 
+/// The observation of the position `(x, y)` of the turn state `[x, vx, y, vy, omega]`, with
+/// independent noise of variance `var` per axis.
+pub fn turn_state_position_observation<T: RealField + Copy>(
+    var: f64,
+) -> Result<LinearObservation<T, U5, U2>> {
+    let mut h = Matrix2x5::<T>::zeros();
+    h[(0, 0)] = T::one();
+    h[(1, 2)] = T::one();
+    if !(var.is_finite() && var > 0.0) {
+        return Err(KalmanError::InvalidParameter {
+            name: "var",
+            reason: format!("observation variance must be finite and positive, got {var}"),
+        });
+    }
+    LinearObservation::new(h, Matrix2::identity() * nalgebra::convert::<f64, T>(var))
+}
+
 /// An [`Imm`] run by time steps, for [`drive`](crate::driver::drive): `make(dt)` builds the
 /// IMM (its mode filters and transition matrix) for a step of `dt` seconds; the last one
 /// built is reused while the step stays the same.
@@ -586,7 +611,7 @@ where
     }
 
     fn estimate(&self) -> Result<Gaussian<T, D>> {
-        Ok(self.state.combined())
+        self.state.combined()
     }
 
     fn forecast_at(&self, offsets: &[T]) -> Result<Vec<Gaussian<T, D>>> {
@@ -598,7 +623,7 @@ where
                     Some((built_dt, imm)) if *built_dt == dt => imm.predict(&self.state),
                     _ => (self.make)(dt)?.predict(&self.state),
                 }?;
-                Ok(state.combined())
+                state.combined()
             })
             .collect()
     }

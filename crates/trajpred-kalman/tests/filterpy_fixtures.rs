@@ -420,13 +420,33 @@ fn imm_of_cv_and_ca_modes_matches_filterpy_step_by_step_and_forecast() {
         .map(|z| (!z.is_null()).then(|| mat(z, u2, u1)))
         .collect();
     let check = |state: &ImmState<f64, Const<6>>, cbar: &[f64], theirs: &Value, at: &str| {
-        let combined = state.combined();
-        close_tol(&combined.mean, &mat(&theirs["x"], u6, u1), IMM_TOL, &format!("{at} x"));
-        close_tol(&combined.covariance, &mat(&theirs["P"], u6, u6), IMM_TOL, &format!("{at} P"));
+        let combined = state.combined().unwrap();
+        close_tol(
+            &combined.mean,
+            &mat(&theirs["x"], u6, u1),
+            IMM_TOL,
+            &format!("{at} x"),
+        );
+        close_tol(
+            &combined.covariance,
+            &mat(&theirs["P"], u6, u6),
+            IMM_TOL,
+            &format!("{at} P"),
+        );
         let mu = DVector::from_column_slice(state.probabilities());
-        close_tol(&mu, &DVector::from_vec(vec_of(&theirs["mu"])), IMM_TOL, &format!("{at} mu"));
+        close_tol(
+            &mu,
+            &DVector::from_vec(vec_of(&theirs["mu"])),
+            IMM_TOL,
+            &format!("{at} mu"),
+        );
         let cbar = DVector::from_column_slice(cbar);
-        close_tol(&cbar, &DVector::from_vec(vec_of(&theirs["cbar"])), IMM_TOL, &format!("{at} cbar"));
+        close_tol(
+            &cbar,
+            &DVector::from_vec(vec_of(&theirs["cbar"])),
+            IMM_TOL,
+            &format!("{at} cbar"),
+        );
         let xs = list(&theirs["mode_x"], u6, u1);
         let ps = list(&theirs["mode_P"], u6, u6);
         for (j, g) in state.modes().iter().enumerate() {
@@ -447,9 +467,17 @@ fn imm_of_cv_and_ca_modes_matches_filterpy_step_by_step_and_forecast() {
         } else {
             let lls = DVector::from_vec(ours.mode_log_likelihoods.clone());
             let their_lls = DVector::from_vec(vec_of(&theirs["mode_log_likelihood"]));
-            close_tol(&lls, &their_lls, IMM_TOL, &format!("{at} mode log-likelihoods"));
+            close_tol(
+                &lls,
+                &their_lls,
+                IMM_TOL,
+                &format!("{at} mode log-likelihoods"),
+            );
             let ll = theirs["log_likelihood"].as_f64().unwrap();
-            assert!((ours.log_likelihood - ll).abs() <= IMM_TOL * ll.abs().max(1.0), "{at}");
+            assert!(
+                (ours.log_likelihood - ll).abs() <= IMM_TOL * ll.abs().max(1.0),
+                "{at}"
+            );
         }
     }
     assert_eq!(missing, 2, "the fixture has two missing fixes");
@@ -458,7 +486,10 @@ fn imm_of_cv_and_ca_modes_matches_filterpy_step_by_step_and_forecast() {
         .iter()
         .filter(|s| s.state.probabilities()[1] > 0.5)
         .count();
-    assert!(ca_top >= 6, "CA mode on top at {ca_top} of 12 accelerating steps");
+    assert!(
+        ca_top >= 6,
+        "CA mode on top at {ca_top} of 12 accelerating steps"
+    );
     let last = &steps.last().unwrap().state;
     let forecast = imm.forecast(last, 5).unwrap();
     let their_forecast = fx["forecast"].as_array().unwrap();
@@ -469,7 +500,11 @@ fn imm_of_cv_and_ca_modes_matches_filterpy_step_by_step_and_forecast() {
         check(ours, &cbar, theirs, &format!("forecast {k}"));
         // the mode probabilities follow mu M^k
         probs = (0..3)
-            .map(|j| (0..3).map(|i| probs[i] * imm.transition_matrix()[(i, j)]).sum())
+            .map(|j| {
+                (0..3)
+                    .map(|i| probs[i] * imm.transition_matrix()[(i, j)])
+                    .sum()
+            })
             .collect();
         for (a, b) in cbar.iter().zip(&probs) {
             assert!((a - b).abs() < 1e-14, "forecast {k}: {a} vs mu M^k {b}");
