@@ -3,6 +3,7 @@
 mod cv_time;
 mod gskf;
 mod hmm;
+mod imm;
 mod kf_dynamic;
 mod kf_time;
 mod particle;
@@ -11,6 +12,7 @@ mod poly;
 pub use cv_time::CvTime;
 pub use gskf::{Gsc, Gskf, GskfParams};
 pub use hmm::{Hmm, HmmParams};
+pub use imm::{ImmParams, ImmPredictor};
 pub use kf_dynamic::{Continuation, KfDynamic, KfDynamicParams, NaiveKf};
 pub use kf_time::{KfTime, KfTimeParams};
 pub use particle::{ParticleKind, ParticleParams, ParticlePredictor};
@@ -54,4 +56,17 @@ pub(crate) fn step_interval(history: &Trajectory, window: usize) -> f64 {
     }
     let t = history.times();
     (t[n - 1] - t[n - w.min(n)]) / (w.min(n) - 1) as f64
+}
+
+/// The `horizon` forecast times after the end of `history`, spaced by the history's mean
+/// interval (1 s for a single point).
+pub(crate) fn forecast_times_on_mean_interval(history: &Trajectory, horizon: usize) -> Vec<f64> {
+    let t = history.times();
+    let n = t.len();
+    let dt = if n >= 2 {
+        (t[n - 1] - t[0]) / (n - 1) as f64
+    } else {
+        1.0
+    };
+    (1..=horizon).map(|k| t[n - 1] + dt * k as f64).collect()
 }
