@@ -142,6 +142,17 @@ impl Part {
         }
     }
 
+    /// Counts step `k` (an update when `observed`); its log-likelihood must be finite.
+    fn count_step(&mut self, k: u64, observed: bool, log_likelihood: f64) {
+        self.steps += 1;
+        if observed {
+            self.updates += 1;
+        }
+        if !log_likelihood.is_finite() {
+            self.fail(format!("step {k}: log-likelihood {log_likelihood}"));
+        }
+    }
+
     fn fail(&mut self, what: String) {
         self.violations += 1;
         if self.messages.len() < 5 {
@@ -201,14 +212,7 @@ fn run_track<D, F>(
                 return;
             }
         };
-        part.steps += 1;
-        if z.is_some() {
-            part.updates += 1;
-        }
-        let ll = step.log_likelihood();
-        if !ll.is_finite() {
-            part.fail(format!("step {k}: log-likelihood {ll}"));
-        }
+        part.count_step(k, z.is_some(), step.log_likelihood());
         state = step.posterior().clone();
         if k.is_multiple_of(check_every) || k == steps {
             part.nees(&state, truth);
@@ -559,13 +563,7 @@ pub fn soak_imm(
                     break;
                 }
             };
-            part.steps += 1;
-            if z.is_some() {
-                part.updates += 1;
-                if !step.log_likelihood.is_finite() {
-                    part.fail(format!("step {k}: log-likelihood {}", step.log_likelihood));
-                }
-            }
+            part.count_step(k, z.is_some(), step.log_likelihood);
             let sum: f64 = step.state.probabilities().iter().sum();
             if (sum - 1.0).abs() > 1e-12 {
                 part.fail(format!("step {k}: mode probabilities sum to {sum}"));

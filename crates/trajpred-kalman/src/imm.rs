@@ -558,10 +558,8 @@ where
     own_output: bool,
 }
 
-impl<T, D, F, Make> TimedImm<T, D, F, Make>
+impl<T: RealField + Copy, D: Dim, F, Make> TimedImm<T, D, F, Make>
 where
-    T: RealField + Copy,
-    D: Dim,
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     /// An IMM starting from `state`, `make` building it for each time step.

@@ -10,14 +10,14 @@
 //! turn-rate density and the mean sojourn time in a mode maximise the IMM's own likelihood
 //! (the same grid search). See `docs/kalman.md`, section "IMM".
 
-use super::{forecast_times_on_mean_interval, invalid, kf_time::maximise, positions_forecast};
+use super::{
+    forecast_times_on_mean_interval, invalid, kf_time::maximise, offsets_after, positions_forecast,
+};
 use crate::predictors::{KfTime, KfTimeParams};
 use nalgebra::{Matrix5, U2, U5, Vector2, Vector5};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use trajpred_core::{
-    Error, Forecast, Gaussian, Predictor, Result, Trajectory, check_forecast_args,
-};
+use trajpred_core::{Error, Forecast, Gaussian, Predictor, Result, Trajectory};
 use trajpred_kalman::driver::{TimeStepFilter, drive};
 use trajpred_kalman::imm::{
     Imm, ImmState, TimedImm, constant_velocity_in_turn_state, coordinated_turn_continuous,
@@ -239,14 +239,11 @@ impl Predictor for ImmPredictor {
     }
 
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
-        check_forecast_args(history, horizon, 1)?;
-        self.forecast_times(history, &forecast_times_on_mean_interval(history, horizon))
+        self.forecast_times(history, &forecast_times_on_mean_interval(history, horizon)?)
     }
 
     fn forecast_times(&self, history: &Trajectory, times: &[f64]) -> Result<Forecast> {
-        check_forecast_args(history, times.len(), 1)?;
-        let last = history.times()[history.len() - 1];
-        let offsets: Vec<f64> = times.iter().map(|&t| t - last).collect();
+        let offsets = offsets_after(history, times)?;
         let f = Self::run(history, self.params)?;
         let states = f.forecast_at(&offsets).map_err(kalman)?;
         // positions_forecast reads the first d components: gather (x, y) from [x, vx, y, ...]

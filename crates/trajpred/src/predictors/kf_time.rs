@@ -4,13 +4,11 @@
 //! likelihood on the training tracks. Run through the filter driver
 //! ([`trajpred_kalman::driver`]); forecasts at any future times.
 
-use super::{forecast_times_on_mean_interval, invalid, positions_forecast};
+use super::{forecast_times_on_mean_interval, invalid, offsets_after, positions_forecast};
 use nalgebra::{Const, DefaultAllocator, Dim, Dyn, OMatrix, OVector, U1, U2, U3, U4, U6, U9};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use trajpred_core::{
-    Error, Forecast, Gaussian, Predictor, Result, Trajectory, check_forecast_args,
-};
+use trajpred_core::{Error, Forecast, Gaussian, Predictor, Result, Trajectory};
 use trajpred_kalman::driver::{TimeStepFilter, Timed, drive};
 use trajpred_kalman::motion::{
     KinematicLayout, StateOrder, damped_velocity, kinematic_continuous, position_observation,
@@ -310,14 +308,11 @@ impl Predictor for KfTime {
     }
 
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
-        check_forecast_args(history, horizon, 1)?;
-        self.forecast_times(history, &forecast_times_on_mean_interval(history, horizon))
+        self.forecast_times(history, &forecast_times_on_mean_interval(history, horizon)?)
     }
 
     fn forecast_times(&self, history: &Trajectory, times: &[f64]) -> Result<Forecast> {
-        check_forecast_args(history, times.len(), 1)?;
-        let last = history.times()[history.len() - 1];
-        let offsets: Vec<f64> = times.iter().map(|&t| t - last).collect();
+        let offsets = offsets_after(history, times)?;
         sized!(self, history.dim(), forecast_sized(history, &offsets))
     }
 }

@@ -59,8 +59,12 @@ pub(crate) fn step_interval(history: &Trajectory, window: usize) -> f64 {
 }
 
 /// The `horizon` forecast times after the end of `history`, spaced by the history's mean
-/// interval (1 s for a single point).
-pub(crate) fn forecast_times_on_mean_interval(history: &Trajectory, horizon: usize) -> Vec<f64> {
+/// interval (1 s for a single point), the forecast arguments checked.
+pub(crate) fn forecast_times_on_mean_interval(
+    history: &Trajectory,
+    horizon: usize,
+) -> Result<Vec<f64>> {
+    trajpred_core::check_forecast_args(history, horizon, 1)?;
     let t = history.times();
     let n = t.len();
     let dt = if n >= 2 {
@@ -68,5 +72,12 @@ pub(crate) fn forecast_times_on_mean_interval(history: &Trajectory, horizon: usi
     } else {
         1.0
     };
-    (1..=horizon).map(|k| t[n - 1] + dt * k as f64).collect()
+    Ok((1..=horizon).map(|k| t[n - 1] + dt * k as f64).collect())
+}
+
+/// The offsets of `times` after the end of `history`, the forecast arguments checked.
+pub(crate) fn offsets_after(history: &Trajectory, times: &[f64]) -> Result<Vec<f64>> {
+    trajpred_core::check_forecast_args(history, times.len(), 1)?;
+    let last = history.times()[history.len() - 1];
+    Ok(times.iter().map(|&t| t - last).collect())
 }
