@@ -228,6 +228,9 @@ where
     pub log_likelihood: T,
 }
 
+/// The mixing stage's result: `cbar` and each mode's mixed start.
+type Mixed<T, D> = (Vec<T>, Vec<Gaussian<T, D>>);
+
 /// The IMM filter over the mode filters `F` (see the module documentation).
 #[derive(Debug, Clone)]
 pub struct Imm<T: RealField, F> {
@@ -272,7 +275,7 @@ impl<T: RealField + Copy, F> Imm<T, F> {
     }
 
     /// The mixing stage: `cbar` and the mixed start `N(x0_j, P0_j)` of every mode.
-    fn mix<D: Dim>(&self, state: &ImmState<T, D>) -> Result<(Vec<T>, Vec<Gaussian<T, D>>)>
+    fn mix<D: Dim>(&self, state: &ImmState<T, D>) -> Result<Mixed<T, D>>
     where
         DefaultAllocator: Allocator<D> + Allocator<D, D>,
     {

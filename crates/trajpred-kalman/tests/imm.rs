@@ -87,12 +87,10 @@ fn the_turn_mode_dominates_a_turning_track_and_cv_a_straight_one() {
     assert!(straight < 0.5, "straight track: CT probability {straight}");
 }
 
+type ScalarKf = Kf<LinearTransition<f64, U1>, LinearObservation<f64, U1, U1>>;
+
 /// Two scalar random-walk-free modes `x' = x` observed with noise variance `r_a`, `r_b`.
-fn scalar_pair(
-    r_a: f64,
-    r_b: f64,
-    m: [f64; 4],
-) -> Imm<f64, Kf<LinearTransition<f64, U1>, LinearObservation<f64, U1, U1>>> {
+fn scalar_pair(r_a: f64, r_b: f64, m: [f64; 4]) -> Imm<f64, ScalarKf> {
     let mode = |r: f64| {
         Kf::new(
             LinearTransition::new(Matrix1::new(1.0), Matrix1::new(0.0)).expect("transition"),
@@ -188,8 +186,8 @@ fn one_mode_is_the_plain_filter() {
     let theirs = kf.filter(&g, &zs).expect("kf");
     for (a, b) in ours.iter().zip(&theirs) {
         let c = a.state.combined().expect("combined");
-        assert!((c.mean - &b.posterior().mean).amax() < 1e-12);
-        assert!((c.covariance - &b.posterior().covariance).amax() < 1e-12);
+        assert!((c.mean - b.posterior().mean).amax() < 1e-12);
+        assert!((c.covariance - b.posterior().covariance).amax() < 1e-12);
         assert!((a.log_likelihood - b.log_likelihood()).abs() < 1e-12);
         assert_eq!(a.state.probabilities(), &[1.0]);
     }
