@@ -4,7 +4,9 @@
 //! - UKF, coordinated turn, range-bearing observations from a sensor at the origin on even
 //!   tracks and position observations on odd ones;
 //! - the filter driver `driver::{Timed, drive}` with a constant-velocity KF whose model is
-//!   rebuilt for irregular time steps (continuous white-noise `Q`), fed in chunks.
+//!   rebuilt for irregular time steps (continuous white-noise `Q`), fed in chunks;
+//! - the IMM, constant-velocity and coordinated-turn modes, on a target that flies straight
+//!   and turns in turn.
 //!
 //! Every `check_every` steps the filter's covariance must be finite, symmetric
 //! (`|P - P^T|_max <= SYM_TOL * max(1, |P|_max)`) and positive semi-definite (the smallest
@@ -16,7 +18,8 @@
 //! cargo run --release -p trajpred-kalman --example soak -- <total steps> <seed>
 //! ```
 //!
-//! The steps are split 40 % KF, 30 % UKF, 30 % driver, in tracks of up to 10^6 steps.
+//! The steps are split 30 % KF, 25 % UKF, 25 % driver, 20 % IMM, in tracks of up to 10^6
+//! steps.
 
 use nalgebra::{DMatrix, Dim, Matrix2, Matrix2x4, Matrix2x5, OMatrix, U2, U4, U5, Vector2};
 use nalgebra::{DefaultAllocator, allocator::Allocator};
@@ -26,11 +29,15 @@ use rand_distr::StandardNormal;
 use std::time::Instant;
 use trajpred_core::Gaussian;
 use trajpred_kalman::driver::{Timed, drive};
+use trajpred_kalman::imm::{
+    Imm, ImmState, constant_velocity_in_turn_state, coordinated_turn_continuous,
+    turn_state_position_observation, uniform_switching,
+};
 use trajpred_kalman::motion::{
     KinematicLayout, StateOrder, constant_velocity, kinematic_continuous, position_observation,
 };
 use trajpred_kalman::{
-    CoordinatedTurn, Filter, KalmanError, Kf, LinearObservation, LinearTransition,
+    CoordinatedTurn, Ekf, Filter, KalmanError, Kf, LinearObservation, LinearTransition,
     MerweSigmaPoints, RangeBearing, Transition, Ukf,
 };
 
@@ -135,6 +142,17 @@ impl Part {
         }
     }
 
+    /// Counts step `k` (an update when `observed`); its log-likelihood must be finite.
+    fn count_step(&mut self, k: u64, observed: bool, log_likelihood: f64) {
+        self.steps += 1;
+        if observed {
+            self.updates += 1;
+        }
+        if !log_likelihood.is_finite() {
+            self.fail(format!("step {k}: log-likelihood {log_likelihood}"));
+        }
+    }
+
     fn fail(&mut self, what: String) {
         self.violations += 1;
         if self.messages.len() < 5 {
@@ -194,14 +212,7 @@ fn run_track<D, F>(
                 return;
             }
         };
-        part.steps += 1;
-        if z.is_some() {
-            part.updates += 1;
-        }
-        let ll = step.log_likelihood();
-        if !ll.is_finite() {
-            part.fail(format!("step {k}: log-likelihood {ll}"));
-        }
+        part.count_step(k, z.is_some(), step.log_likelihood());
         state = step.posterior().clone();
         if k.is_multiple_of(check_every) || k == steps {
             part.nees(&state, truth);
@@ -484,6 +495,110 @@ pub fn soak_driver(
     part
 }
 
+/// The IMM: constant-velocity (KF) and coordinated-turn (EKF) modes on `[x, vx, y, vy,
+/// omega]`, 1 s steps, switching by [`uniform_switching`] (mean sojourn 30 s); the truth
+/// flies straight and turns in turn (a turn rate of +-0.05 rad/s for 2 % of its steps on
+/// average, switching on and off at random), positions observed with variance 4 (10 %
+/// missing). Checks the combined covariance and every mode's; the log-likelihood of every
+/// observed step must be finite and the mode probabilities must sum to 1.
+pub fn soak_imm(
+    steps: u64,
+    track_len: u64,
+    check_every: u64,
+    rng: &mut ChaCha8Rng,
+    tamper: Option<Tamper>,
+) -> Part {
+    let start = Instant::now();
+    let mut part = Part::default();
+    let (dt, q, pos_var) = (1.0, 0.05, 4.0);
+    let obs = turn_state_position_observation::<f64>(pos_var).expect("model");
+    let cv = Kf::new(
+        constant_velocity_in_turn_state::<f64>(dt, q).expect("model"),
+        obs.clone(),
+    )
+    .expect("kf");
+    let ct = Ekf::new(
+        coordinated_turn_continuous::<f64>(dt, q, 1e-4).expect("model"),
+        obs,
+    )
+    .expect("ekf");
+    let modes: Vec<Box<dyn Filter<f64, U5, U2>>> = vec![Box::new(cv), Box::new(ct)];
+    let imm = Imm::new(modes, uniform_switching(2, dt, 30.0).expect("matrix")).expect("imm");
+    let truth = CoordinatedTurn::<f64>::new(dt, 0.0, 0.0).expect("model");
+    let mut left = steps;
+    while left > 0 {
+        let n = left.min(track_len);
+        left -= n;
+        part.tracks += 1;
+        let mut x = nalgebra::Vector5::new(gauss(rng) * 100.0, 8.0, gauss(rng) * 100.0, 0.0, 0.0);
+        let start = Gaussian {
+            mean: nalgebra::Vector5::new(x[0], 0.0, x[2], 0.0, 0.0),
+            covariance: nalgebra::Matrix5::from_diagonal(&nalgebra::Vector5::new(
+                25.0, 25.0, 25.0, 25.0, 0.01,
+            )),
+        };
+        let mut state = ImmState::uniform(start, 2).expect("state");
+        for k in 1..=n {
+            // turns of about 20 s, straight legs of about 1000 s, speed kept near 8 m/s
+            if x[4] != 0.0 && rng.random_bool(0.05) {
+                x[4] = 0.0;
+            } else if x[4] == 0.0 && rng.random_bool(0.001) {
+                x[4] = if rng.random_bool(0.5) { 0.05 } else { -0.05 };
+            }
+            x = truth.transition(&x).expect("truth");
+            let speed = x[1].hypot(x[3]).max(1e-9);
+            x[1] += gauss(rng) * 0.05 + 0.01 * (8.0 / speed - 1.0) * x[1];
+            x[3] += gauss(rng) * 0.05 + 0.01 * (8.0 / speed - 1.0) * x[3];
+            let pos = Vector2::new(x[0], x[2]);
+            let z = (!rng.random_bool(0.1)).then(|| {
+                Vector2::new(
+                    x[0] + gauss(rng) * pos_var.sqrt(),
+                    x[2] + gauss(rng) * pos_var.sqrt(),
+                )
+            });
+            let step = match imm.step(&state, z.as_ref()) {
+                Ok(s) => s,
+                Err(e) => {
+                    part.error(&e);
+                    break;
+                }
+            };
+            part.count_step(k, z.is_some(), step.log_likelihood);
+            let sum: f64 = step.state.probabilities().iter().sum();
+            if (sum - 1.0).abs() > 1e-12 {
+                part.fail(format!("step {k}: mode probabilities sum to {sum}"));
+            }
+            state = step.state;
+            if k.is_multiple_of(check_every) || k == n {
+                let combined = match state.combined() {
+                    Ok(c) => c,
+                    Err(e) => {
+                        part.error(&e);
+                        break;
+                    }
+                };
+                part.nees(&combined, pos);
+                for g in state.modes() {
+                    if let Err(e) = check_cov(&g.covariance) {
+                        part.fail(format!("step {k}: mode covariance {e}"));
+                    }
+                }
+                match tamper {
+                    None => part.check(&combined.covariance, k),
+                    Some(t) => {
+                        let p = &combined.covariance;
+                        let mut d = DMatrix::from_fn(5, 5, |i, j| p[(i, j)]);
+                        t(&mut d);
+                        part.check(&d, k);
+                    }
+                }
+            }
+        }
+    }
+    part.seconds = start.elapsed().as_secs_f64();
+    part
+}
+
 /// Prints one part's figures.
 #[allow(clippy::print_stdout)] // a report on the terminal is the point of the example
 pub fn print(name: &str, p: &Part) {
@@ -520,24 +635,27 @@ fn main() {
         "soak: {total} steps, seed {seed}, tracks of up to {track_len}, checks every {check_every}"
     );
     println!("VmRSS at start: {rss0:?} KiB");
-    let kf = soak_kf(total * 4 / 10, track_len, check_every, &mut rng, None);
+    let kf = soak_kf(total * 3 / 10, track_len, check_every, &mut rng, None);
     let rss1 = vm_rss_kib();
     print("KF", &kf);
     println!("VmRSS after KF: {rss1:?} KiB");
-    let ukf = soak_ukf(total * 3 / 10, track_len, check_every, &mut rng, None);
+    let ukf = soak_ukf(total / 4, track_len, check_every, &mut rng, None);
     print("UKF", &ukf);
     println!("VmRSS after UKF: {:?} KiB", vm_rss_kib());
-    let drv = soak_driver(
-        total - total * 4 / 10 - total * 3 / 10,
+    let drv = soak_driver(total / 4, track_len, check_every, &mut rng, None);
+    print("driver", &drv);
+    println!("VmRSS after driver: {:?} KiB", vm_rss_kib());
+    let imm = soak_imm(
+        total - total * 3 / 10 - total / 4 - total / 4,
         track_len,
         check_every,
         &mut rng,
         None,
     );
-    print("driver", &drv);
+    print("IMM", &imm);
     let rss2 = vm_rss_kib();
     println!("VmRSS at end: {rss2:?} KiB");
-    let all = [&kf, &ukf, &drv];
+    let all = [&kf, &ukf, &drv, &imm];
     let steps: u64 = all.iter().map(|p| p.steps).sum();
     let bad: u64 = all.iter().map(|p| p.violations + p.errors).sum();
     println!(

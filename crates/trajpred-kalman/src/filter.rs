@@ -306,6 +306,42 @@ where
     }
 }
 
+/// A boxed filter is a filter (every method forwarded), so that filters of different types
+/// can serve together, as the modes of an [`Imm`](crate::Imm).
+impl<T: RealField + Copy, D: Dim, M: Dim, F: Filter<T, D, M> + ?Sized> Filter<T, D, M> for Box<F>
+where
+    DefaultAllocator: FilterAllocator<D, M>,
+{
+    fn predict(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
+        (**self).predict(state)
+    }
+
+    fn update(&self, prior: &Gaussian<T, D>, z: &OVector<T, M>) -> Result<Update<T, D, M>> {
+        (**self).update(prior, z)
+    }
+
+    fn update_predicted(
+        &self,
+        prior: &Gaussian<T, D>,
+        z: &OVector<T, M>,
+    ) -> Result<Update<T, D, M>> {
+        (**self).update_predicted(prior, z)
+    }
+
+    fn predict_own_output(&self, state: &Gaussian<T, D>) -> Result<Gaussian<T, D>> {
+        (**self).predict_own_output(state)
+    }
+
+    fn predict_update(
+        &self,
+        state: &Gaussian<T, D>,
+        z: &OVector<T, M>,
+        own_output: bool,
+    ) -> Result<PredictionAndUpdate<T, D, M>> {
+        (**self).predict_update(state, z, own_output)
+    }
+}
+
 /// A prediction and its update by an observation ([`Filter::predict_update`]).
 pub type PredictionAndUpdate<T, D, M> = (Gaussian<T, D>, Update<T, D, M>);
 

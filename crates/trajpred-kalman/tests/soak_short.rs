@@ -1,6 +1,6 @@
-//! A short version of the soak (`examples/soak.rs`, included here): 10^5 filter steps of the
-//! KF, the UKF (range-bearing and position observations) and the filter driver over
-//! irregular times, every 100 steps checking the covariance finite, symmetric and positive
+//! A short version of the soak (`examples/soak.rs`, included here): 1.2 x 10^5 filter steps of the
+//! KF, the UKF (range-bearing and position observations), the filter driver over
+//! irregular times and the IMM (constant velocity + coordinated turn), every 100 steps checking the covariance finite, symmetric and positive
 //! semi-definite (tolerances `SYM_TOL`, `PSD_TOL` of the example) and the log-likelihood
 //! finite.
 
@@ -11,7 +11,7 @@ mod soak;
 use nalgebra::{DMatrix, Matrix3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use soak::{Part, check_cov, soak_driver, soak_kf, soak_ukf};
+use soak::{Part, check_cov, soak_driver, soak_imm, soak_kf, soak_ukf};
 
 fn assert_clean(name: &str, p: &Part, steps: u64) {
     assert_eq!(p.steps, steps, "{name}: steps ({:?})", p.messages);
@@ -58,11 +58,21 @@ fn a_short_soak_keeps_every_invariant() {
         "UKF NEES {}",
         ukf.mean_nees()
     );
+    let imm = soak_imm(20_000, 10_000, 100, &mut rng, None);
+    assert_clean("IMM", &imm, 20_000);
+    assert_eq!(imm.tracks, 2);
+    // the IMM's combined covariance is the mixture's: NEES near 2 as well
+    assert!(
+        (1.0..4.0).contains(&imm.mean_nees()),
+        "IMM NEES {}",
+        imm.mean_nees()
+    );
     eprintln!(
-        "NEES: KF {:.2}, UKF {:.2}, driver {:.2}",
+        "NEES: KF {:.2}, UKF {:.2}, driver {:.2}, IMM {:.2}",
         kf.mean_nees(),
         ukf.mean_nees(),
-        drv.mean_nees()
+        drv.mean_nees(),
+        imm.mean_nees()
     );
 }
 
@@ -106,4 +116,7 @@ fn a_broken_covariance_fails_the_soak() {
         drv.violations > 0 && drv.violations == drv.checks,
         "{drv:?}"
     );
+    let imm = soak_imm(2_000, 1_000, 100, &mut rng, Some(make_indefinite));
+    assert_eq!(imm.violations, imm.checks, "{:?}", imm.messages);
+    assert!(imm.messages[0].contains("not PSD"), "{:?}", imm.messages);
 }

@@ -80,6 +80,10 @@ pub const METHODS: &[MethodInfo] = &[
         description: "Kalman filter over actual time: constant acceleration, continuous white-noise jerk, q and r fitted by maximum likelihood",
     },
     MethodInfo {
+        name: "imm",
+        description: "interacting multiple model over actual time: constant velocity + coordinated turn (EKF), noise and switching fitted by maximum likelihood",
+    },
+    MethodInfo {
         name: "cv-time",
         description: "last velocity (last two points over their time difference), on the history's mean interval",
     },
@@ -202,6 +206,7 @@ pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
             ..Default::default()
         })?),
         "cv-time" => Box::new(CvTime::new()),
+        "imm" => Box::new(ImmPredictor::new(ImmParams::default())?),
         "poly1" | "poly2" => Box::new(PolyFit::new(PolyFitParams {
             degree: if name == "poly1" { 1 } else { 2 },
             points: opts.poly_points,

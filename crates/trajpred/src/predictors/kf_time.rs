@@ -5,13 +5,11 @@
 //! ([`trajpred_kalman::driver`]); forecasts at any future times.
 
 use super::fitted::{At, exact};
-use super::{invalid, positions_forecast};
+use super::{forecast_times_on_mean_interval, invalid, offsets_after, positions_forecast};
 use nalgebra::{Const, DefaultAllocator, Dim, Dyn, OMatrix, OVector, U1, U2, U3, U4, U6, U9};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use trajpred_core::{
-    Error, Forecast, Gaussian, Predictor, Result, Trajectory, check_forecast_args,
-};
+use trajpred_core::{Error, Forecast, Gaussian, Predictor, Result, Trajectory};
 use trajpred_kalman::driver::{TimeStepFilter, Timed, drive};
 use trajpred_kalman::motion::{
     KinematicLayout, StateOrder, damped_velocity, kinematic_continuous, position_observation,
@@ -240,7 +238,11 @@ impl KfTime {
 
 /// Maximises `f` over a box of `(log10 q, log10 r)`: a coarse grid, then three rounds of
 /// a finer grid around the best point.
-fn maximise(f: impl Fn(f64, f64) -> f64, q: (f64, f64), r: (f64, f64)) -> (f64, f64, f64) {
+pub(super) fn maximise(
+    f: impl Fn(f64, f64) -> f64,
+    q: (f64, f64),
+    r: (f64, f64),
+) -> (f64, f64, f64) {
     let mut best = (f64::NEG_INFINITY, q.0, r.0);
     let (mut qs, mut rs) = ((q.1 - q.0) / 6.0, (r.1 - r.0) / 6.0);
     let (mut qc, mut rc) = ((q.0 + q.1) / 2.0, (r.0 + r.1) / 2.0);
@@ -332,22 +334,11 @@ impl Predictor for KfTime {
     }
 
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
-        check_forecast_args(history, horizon, 1)?;
-        let t = history.times();
-        let n = t.len();
-        let dt = if n >= 2 {
-            (t[n - 1] - t[0]) / (n - 1) as f64
-        } else {
-            1.0
-        };
-        let times: Vec<f64> = (1..=horizon).map(|k| t[n - 1] + dt * k as f64).collect();
-        self.forecast_times(history, &times)
+        self.forecast_times(history, &forecast_times_on_mean_interval(history, horizon)?)
     }
 
     fn forecast_times(&self, history: &Trajectory, times: &[f64]) -> Result<Forecast> {
-        check_forecast_args(history, times.len(), 1)?;
-        let last = history.times()[history.len() - 1];
-        let offsets: Vec<f64> = times.iter().map(|&t| t - last).collect();
+        let offsets = offsets_after(history, times)?;
         sized!(self, history.dim(), forecast_sized(history, &offsets))
     }
 }

@@ -4,6 +4,7 @@ mod cv_time;
 mod fitted;
 mod gskf;
 mod hmm;
+mod imm;
 mod kf_dynamic;
 mod kf_time;
 mod particle;
@@ -12,6 +13,7 @@ mod poly;
 pub use cv_time::CvTime;
 pub use gskf::{Gsc, Gskf, GskfParams};
 pub use hmm::{Hmm, HmmParams, MAX_HMM_STATES};
+pub use imm::{ImmParams, ImmPredictor};
 pub use kf_dynamic::{Continuation, KfDynamic, KfDynamicParams, NaiveKf};
 pub use kf_time::{KfTime, KfTimeParams};
 pub use particle::{ParticleKind, ParticleParams, ParticlePredictor};
@@ -55,4 +57,28 @@ pub(crate) fn step_interval(history: &Trajectory, window: usize) -> f64 {
     }
     let t = history.times();
     (t[n - 1] - t[n - w.min(n)]) / (w.min(n) - 1) as f64
+}
+
+/// The `horizon` forecast times after the end of `history`, spaced by the history's mean
+/// interval (1 s for a single point), the forecast arguments checked.
+pub(crate) fn forecast_times_on_mean_interval(
+    history: &Trajectory,
+    horizon: usize,
+) -> Result<Vec<f64>> {
+    trajpred_core::check_forecast_args(history, horizon, 1)?;
+    let t = history.times();
+    let n = t.len();
+    let dt = if n >= 2 {
+        (t[n - 1] - t[0]) / (n - 1) as f64
+    } else {
+        1.0
+    };
+    Ok((1..=horizon).map(|k| t[n - 1] + dt * k as f64).collect())
+}
+
+/// The offsets of `times` after the end of `history`, the forecast arguments checked.
+pub(crate) fn offsets_after(history: &Trajectory, times: &[f64]) -> Result<Vec<f64>> {
+    trajpred_core::check_forecast_args(history, times.len(), 1)?;
+    let last = history.times()[history.len() - 1];
+    Ok(times.iter().map(|&t| t - last).collect())
 }

@@ -1,0 +1,272 @@
+//! The interacting multiple model filter over actual time ("imm"): a constant-velocity mode
+//! and a coordinated-turn mode (EKF) on the state `[x, vx, y, vy, omega]`, switching at
+//! random ([`trajpred_kalman::imm::uniform_switching`]); the noise of both modes follows each
+//! interval of the track (continuous white noise, as in [`KfTime`]). Run through the filter
+//! driver ([`trajpred_kalman::driver`]); forecasts at any future times with the mixture's
+//! mean and covariance. 2-D tracks only (the turn acts in the plane).
+//!
+//! Fitting, on the training tracks: the acceleration density `q` and observation variance
+//! `r` are [`KfTime`]'s maximum-likelihood fit of the constant-velocity model; then the
+//! turn-rate density and the mean sojourn time in a mode maximise the IMM's own likelihood
+//! (the same grid search). See `docs/kalman.md`, section "IMM".
+
+use super::{
+    forecast_times_on_mean_interval, invalid, kf_time::maximise, offsets_after, positions_forecast,
+};
+use crate::predictors::{KfTime, KfTimeParams};
+use nalgebra::{Matrix5, U2, U5, Vector2, Vector5};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use trajpred_core::{Error, Forecast, Gaussian, Predictor, Result, Trajectory};
+use trajpred_kalman::driver::{TimeStepFilter, drive};
+use trajpred_kalman::imm::{
+    Imm, ImmState, TimedImm, constant_velocity_in_turn_state, coordinated_turn_continuous,
+    turn_state_position_observation, uniform_switching,
+};
+use trajpred_kalman::{Ekf, Filter, KalmanError, Kf};
+
+/// Settings of [`ImmPredictor`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ImmParams {
+    /// Spectral density of the white-noise acceleration of both modes (m^2/s^3); fitted.
+    pub spectral_density: f64,
+    /// Observation variance per axis (m^2); fitted.
+    pub r: f64,
+    /// Spectral density of the turn rate's random walk in the turn mode (rad^2/s^3); fitted.
+    pub turn_rate_density: f64,
+    /// Mean time spent in a mode before switching (s); fitted.
+    pub mean_sojourn: f64,
+    /// Variance of the initial velocity components (m^2/s^2).
+    pub initial_rate_variance: f64,
+    /// Variance of the initial turn rate (rad^2/s^2).
+    pub initial_turn_rate_variance: f64,
+    /// Fit the four noise settings on the training tracks.
+    pub fit_noise: bool,
+    /// The fit of `q`, `r` uses at most this many training tracks (evenly spread), the fit of
+    /// the turn and switching settings a quarter of them ...
+    pub fit_tracks: usize,
+    /// ... and at most this many points of each.
+    pub fit_points: usize,
+}
+
+impl Default for ImmParams {
+    fn default() -> Self {
+        ImmParams {
+            spectral_density: 1.0,
+            r: 10.0,
+            turn_rate_density: 1e-3,
+            mean_sojourn: 20.0,
+            initial_rate_variance: 100.0,
+            initial_turn_rate_variance: 0.01,
+            fit_noise: true,
+            fit_tracks: 400,
+            fit_points: 200,
+        }
+    }
+}
+
+impl ImmParams {
+    fn validate(&self) -> Result<()> {
+        for (name, v) in [
+            ("spectral_density", self.spectral_density),
+            ("r", self.r),
+            ("turn_rate_density", self.turn_rate_density),
+            ("mean_sojourn", self.mean_sojourn),
+            ("initial_rate_variance", self.initial_rate_variance),
+            (
+                "initial_turn_rate_variance",
+                self.initial_turn_rate_variance,
+            ),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(invalid(
+                    name,
+                    format!("must be finite and positive, got {v}"),
+                ));
+            }
+        }
+        if self.fit_tracks < 4 || self.fit_points < 3 {
+            return Err(invalid(
+                "fit_tracks",
+                "the fit needs at least 4 tracks of at least 3 points",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The IMM predictor ("imm"): see the module documentation.
+///
+/// ```
+/// use trajpred::predictors::{ImmParams, ImmPredictor};
+/// use trajpred_core::{Predictor, Trajectory};
+/// // 2 m/s along x, sampled at irregular times
+/// let t = vec![0.0, 1.0, 3.0, 3.5, 5.0, 8.0, 9.0];
+/// let x: Vec<f64> = t.iter().map(|t| 2.0 * t).collect();
+/// let tr = Trajectory::from_axes(t, vec![x, vec![0.0; 7]])?;
+/// let p = ImmPredictor::new(ImmParams { fit_noise: false, ..Default::default() })?;
+/// let f = p.forecast_times(&tr, &[10.0, 14.0])?;
+/// assert!((f.step(2)[0] - 28.0).abs() < 1.0);
+/// assert!(f.covariance(2).is_some());
+/// # Ok::<(), trajpred_core::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ImmPredictor {
+    params: ImmParams,
+}
+
+type Mode = Box<dyn Filter<f64, U5, U2>>;
+
+fn kalman(e: KalmanError) -> Error {
+    Error::method("imm", e)
+}
+
+/// The IMM for a step of `dt` seconds under `p`.
+fn build(p: ImmParams, dt: f64) -> trajpred_kalman::Result<Imm<f64, Mode>> {
+    let obs = turn_state_position_observation::<f64>(p.r)?;
+    let cv = Kf::new(
+        constant_velocity_in_turn_state::<f64>(dt, p.spectral_density)?,
+        obs.clone(),
+    )?;
+    let ct = Ekf::new(
+        coordinated_turn_continuous::<f64>(dt, p.spectral_density, p.turn_rate_density)?,
+        obs,
+    )?;
+    let modes: Vec<Mode> = vec![Box::new(cv), Box::new(ct)];
+    Imm::new(modes, uniform_switching(2, dt, p.mean_sojourn)?)
+}
+
+type Run = TimedImm<f64, U5, Mode, Box<dyn Fn(f64) -> trajpred_kalman::Result<Imm<f64, Mode>>>>;
+
+impl ImmPredictor {
+    /// A validated predictor.
+    pub fn new(params: ImmParams) -> Result<Self> {
+        params.validate()?;
+        Ok(ImmPredictor { params })
+    }
+
+    /// The settings, with the fitted noise after [`Predictor::fit`].
+    pub fn params(&self) -> &ImmParams {
+        &self.params
+    }
+
+    /// The IMM after running through `history` under `p`.
+    fn run(history: &Trajectory, p: ImmParams) -> Result<Run> {
+        if history.dim() != 2 {
+            return Err(invalid(
+                "dim",
+                format!(
+                    "the IMM predictor needs 2-D tracks, got {}-D",
+                    history.dim()
+                ),
+            ));
+        }
+        let first = history.point(0);
+        let start = Gaussian::new(
+            Vector5::new(first[0], 0.0, first[1], 0.0, 0.0),
+            Matrix5::from_diagonal(&Vector5::new(
+                p.r,
+                p.initial_rate_variance,
+                p.r,
+                p.initial_rate_variance,
+                p.initial_turn_rate_variance,
+            )),
+        )?;
+        let make: Box<dyn Fn(f64) -> trajpred_kalman::Result<Imm<f64, Mode>>> =
+            Box::new(move |dt| build(p, dt));
+        let mut f = TimedImm::new(make, ImmState::uniform(start, 2).map_err(kalman)?);
+        let z: Vec<Option<Vector2<f64>>> = (0..history.len())
+            .map(|k| {
+                let q = history.point(k);
+                Some(Vector2::new(q[0], q[1]))
+            })
+            .collect();
+        drive(&mut f, history.times(), &z, |_, _| Ok(())).map_err(kalman)?;
+        Ok(f)
+    }
+
+    /// The log-likelihood of the tracks under `p` (a failing track counts `-inf`).
+    fn log_likelihood(tracks: &[Trajectory], p: ImmParams) -> f64 {
+        tracks
+            .par_iter()
+            .map(|t| Self::run(t, p).map_or(f64::NEG_INFINITY, |f| f.log_likelihood()))
+            .sum()
+    }
+}
+
+impl Predictor for ImmPredictor {
+    fn name(&self) -> &str {
+        "imm"
+    }
+
+    fn fit(&mut self, train: &[Trajectory]) -> Result<()> {
+        if !self.params.fit_noise {
+            return Ok(());
+        }
+        let mut kf = KfTime::new(KfTimeParams {
+            derivatives: 2,
+            fit_tracks: self.params.fit_tracks,
+            fit_points: self.params.fit_points,
+            ..Default::default()
+        })?;
+        kf.fit(train)?;
+        let mut p = self.params;
+        (p.spectral_density, p.r) = (kf.params().spectral_density, kf.params().r);
+        let usable: Vec<&Trajectory> = train.iter().filter(|t| t.len() >= 3).collect();
+        let step = usable.len().div_ceil(self.params.fit_tracks / 4).max(1);
+        let tracks: Vec<Trajectory> = usable
+            .iter()
+            .step_by(step)
+            .map(|t| t.slice(0..t.len().min(self.params.fit_points)))
+            .collect::<Result<_>>()?;
+        let (ll, turn, sojourn) = maximise(
+            |turn, sojourn| {
+                let q = ImmParams {
+                    turn_rate_density: turn,
+                    mean_sojourn: sojourn,
+                    ..p
+                };
+                Self::log_likelihood(&tracks, q)
+            },
+            (-7.0, -1.0),
+            (0.0, 3.0),
+        );
+        if ll.is_finite() {
+            (p.turn_rate_density, p.mean_sojourn) = (turn, sojourn);
+        }
+        self.params = p;
+        Ok(())
+    }
+
+    fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
+        self.forecast_times(history, &forecast_times_on_mean_interval(history, horizon)?)
+    }
+
+    fn forecast_times(&self, history: &Trajectory, times: &[f64]) -> Result<Forecast> {
+        let offsets = offsets_after(history, times)?;
+        let f = Self::run(history, self.params)?;
+        let states = f.forecast_at(&offsets).map_err(kalman)?;
+        // positions_forecast reads the first d components: gather (x, y) from [x, vx, y, ...]
+        let states: Vec<Gaussian<f64, U2>> = states
+            .iter()
+            .map(|g| Gaussian {
+                mean: Vector2::new(g.mean[0], g.mean[2]),
+                covariance: nalgebra::Matrix2::new(
+                    g.covariance[(0, 0)],
+                    g.covariance[(0, 2)],
+                    g.covariance[(2, 0)],
+                    g.covariance[(2, 2)],
+                ),
+            })
+            .collect();
+        positions_forecast(&states, 2)
+    }
+
+    fn fitted_summary(&self) -> Option<String> {
+        let p = &self.params;
+        Some(format!(
+            "q = {:.3e} m^2/s^3, r = {:.3e} m^2, turn-rate density {:.3e} rad^2/s^3, mean sojourn {:.3e} s",
+            p.spectral_density, p.r, p.turn_rate_density, p.mean_sojourn
+        ))
+    }
+}
