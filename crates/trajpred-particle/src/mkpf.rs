@@ -3,7 +3,7 @@
 //! Kalman crate's own (`trajpred_kalman::Ukf`, `trajpred_kalman::Ekf`).
 
 use crate::cloud::ParticleCloud;
-use crate::error::{ParticleError, Result};
+use crate::error::Result;
 use crate::gauss::{Density, first_non_finite, log_det_half, psd_factor, shifted, to_f64};
 use crate::pf::{
     MIN_PARTICLES_PER_TASK, ParticleFiltering, PfConfig, StepSummary, log_likelihood,
@@ -15,6 +15,7 @@ use nalgebra::{Cholesky, DefaultAllocator, Dim, OMatrix, OVector, RealField};
 use rand::Rng;
 use rayon::prelude::*;
 use std::marker::PhantomData;
+use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 use trajpred_kalman::FilterAllocator;
 use trajpred_kalman::{
@@ -146,7 +147,7 @@ where
 /// resampled, by the residual scheme every step by default ([`PfConfig`]).
 ///
 /// The transition density needs `Q` positive definite (a singular `Q` is
-/// [`ParticleError::NotPositiveDefinite`] at construction). A particle whose UKF or EKF step
+/// [`trajpred_core::Error::NotPositiveDefinite`] at construction). A particle whose UKF or EKF step
 /// fails (e.g. `S` not positive definite) falls back to the transition prior as its proposal
 /// for that step (counted in [`StepSummary::fallbacks`]). A missing observation propagates
 /// each particle through the transition (weights unchanged) and its covariance by the UKF
@@ -230,8 +231,8 @@ where
     /// An MKPF over `cloud`, every particle starting with the covariance `initial_covariance`
     /// (the paper's `P_0^i = P_0`), with the sigma-point parameters `points` (the paper:
     /// `alpha = 1e-3, beta = 2, kappa = 0`, [`MerweSigmaPoints::default`]). Errors:
-    /// [`ParticleError::DimensionMismatch`], [`ParticleError::NotPositiveDefinite`] (`"Q"`
-    /// must be positive definite, `"R"`, `"P"`), [`ParticleError::Kalman`] (degenerate
+    /// [`trajpred_core::Error::DimensionMismatch`], [`trajpred_core::Error::NotPositiveDefinite`] (`"Q"`
+    /// must be positive definite, `"R"`, `"P"`), [`ParticleError::Kalman`](crate::ParticleError::Kalman) (degenerate
     /// sigma points).
     pub fn new(
         transition: Tr,
@@ -242,18 +243,20 @@ where
     ) -> Result<Self> {
         let n = transition.state_dim();
         if cloud.dim() != n {
-            return Err(ParticleError::DimensionMismatch {
+            return Err(CoreError::DimensionMismatch {
                 what: "particles vs transition",
                 expected: n,
                 got: cloud.dim(),
-            });
+            }
+            .into());
         }
         if initial_covariance.nrows() != n || initial_covariance.ncols() != n {
-            return Err(ParticleError::DimensionMismatch {
+            return Err(CoreError::DimensionMismatch {
                 what: "initial covariance vs transition",
                 expected: n,
                 got: initial_covariance.nrows(),
-            });
+            }
+            .into());
         }
         psd_factor(&initial_covariance, "P")?;
         points.weights(n)?;

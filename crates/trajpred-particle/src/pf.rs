@@ -3,7 +3,7 @@
 //! per-step summary ([`StepSummary`]).
 
 use crate::cloud::ParticleCloud;
-use crate::error::{ParticleError, Result};
+use crate::error::Result;
 use crate::gauss::{Density, first_non_finite, psd_factor, push_normals, shifted};
 use crate::resample::{Resampler, Resampling};
 use crate::weights::{ResamplePolicy, effective_sample_size_log, normalize_log_weights};
@@ -12,6 +12,7 @@ use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
 use rand::Rng;
 use rayon::prelude::*;
 use std::marker::PhantomData;
+use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 use trajpred_kalman::driver::scan;
 use trajpred_kalman::{Observation, Transition};
@@ -64,7 +65,7 @@ where
     /// (`None`: predict only, weights unchanged).
     ///
     /// On error the filter is left as it was before the call (in particular for
-    /// [`ParticleError::AllWeightsZero`], an observation impossible under every particle:
+    /// [`ParticleError::AllWeightsZero`](crate::ParticleError::AllWeightsZero), an observation impossible under every particle:
     /// the caller may skip it and continue).
     fn step<R: Rng + ?Sized>(
         &mut self,
@@ -138,17 +139,19 @@ where
     DefaultAllocator: Allocator<M>,
 {
     if z.nrows() != m {
-        return Err(ParticleError::DimensionMismatch {
+        return Err(CoreError::DimensionMismatch {
             what: "observation",
             expected: m,
             got: z.nrows(),
-        });
+        }
+        .into());
     }
     if let Some(index) = first_non_finite(z) {
-        return Err(ParticleError::NonFinite {
+        return Err(CoreError::NonFinite {
             what: "observation",
             index,
-        });
+        }
+        .into());
     }
     Ok(())
 }
@@ -169,11 +172,12 @@ where
 {
     let zp = observation.observe(x)?;
     if zp.nrows() != z.nrows() {
-        return Err(ParticleError::DimensionMismatch {
+        return Err(CoreError::DimensionMismatch {
             what: "h(x)",
             expected: z.nrows(),
             got: zp.nrows(),
-        });
+        }
+        .into());
     }
     Ok(density.log_density(&observation.observation_residual(z, &zp)))
 }
@@ -193,18 +197,20 @@ where
 {
     let fx = transition.transition(x)?;
     if fx.nrows() != x.nrows() {
-        return Err(ParticleError::DimensionMismatch {
+        return Err(CoreError::DimensionMismatch {
             what: "f(x)",
             expected: x.nrows(),
             got: fx.nrows(),
-        });
+        }
+        .into());
     }
     let out = shifted(&fx, q_factor, e);
     if let Some(index) = first_non_finite(&out) {
-        return Err(ParticleError::NonFinite {
+        return Err(CoreError::NonFinite {
             what: "propagated particle",
             index,
-        });
+        }
+        .into());
     }
     Ok(out)
 }
@@ -315,16 +321,17 @@ where
 {
     /// A filter over `cloud` with the transition (`f`, `Q` positive semi-definite) and the
     /// observation (`h`, `R` positive definite). Errors:
-    /// [`ParticleError::DimensionMismatch`], [`ParticleError::NotPositiveDefinite`] (`"Q"`,
+    /// [`trajpred_core::Error::DimensionMismatch`], [`trajpred_core::Error::NotPositiveDefinite`] (`"Q"`,
     /// `"R"`).
     pub fn new(transition: Tr, observation: Ob, cloud: ParticleCloud<T, D>) -> Result<Self> {
         let n = transition.state_dim();
         if cloud.dim() != n {
-            return Err(ParticleError::DimensionMismatch {
+            return Err(CoreError::DimensionMismatch {
                 what: "particles vs transition",
                 expected: n,
                 got: cloud.dim(),
-            });
+            }
+            .into());
         }
         let q_factor = psd_factor(transition.process_noise(), "Q")?;
         let likelihood = Density::new(observation.observation_noise(), "R")?;

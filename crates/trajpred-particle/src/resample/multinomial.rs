@@ -3,9 +3,10 @@
 use super::Resampler;
 use super::common::*;
 use super::residual::{PARTS_MAX, Part, part_count, resample_scaled, residual_total};
-use crate::error::{ParticleError, Result};
+use crate::error::Result;
 use rand::Rng;
 use rand_distr::{Distribution, Exp1};
+use trajpred_core::Error as CoreError;
 
 /// Multinomial resampling for given uniforms `u_j in [0, 1]`, one draw per uniform, in the
 /// order of the uniforms (the inverse of the cumulative distribution at each `u_j`; this
@@ -17,11 +18,12 @@ use rand_distr::{Distribution, Exp1};
 pub fn multinomial_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) -> Result<()> {
     let c = check_weights(weights, out.len())?;
     if uniforms.len() != out.len() {
-        return Err(ParticleError::LengthMismatch {
+        return Err(CoreError::LengthMismatch {
             what: "uniforms vs output",
             expected: out.len(),
             got: uniforms.len(),
-        });
+        }
+        .into());
     }
     let mut cumsum = Vec::with_capacity(weights.len());
     let mut s = 0.0;

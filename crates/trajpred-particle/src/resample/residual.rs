@@ -5,10 +5,11 @@ use super::Resampler;
 use super::blocks::residual_blocks;
 use super::common::*;
 use super::multinomial::sorted_multinomial;
-use crate::error::{ParticleError, Result};
+use crate::error::Result;
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{Rng, SeedableRng};
 use rand_distr::Distribution;
+use trajpred_core::Error as CoreError;
 
 /// Residual resampling for given uniforms (allocates the residual cumulative sums): the
 /// first `k = sum_i floor(n w_i)` outputs are the deterministic copies in index order, the
@@ -36,11 +37,12 @@ pub fn residual_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) ->
     let (k, _, _) = write_copies(weights, scale, out);
     let m = n - k;
     if uniforms.len() < m {
-        return Err(ParticleError::LengthMismatch {
+        return Err(CoreError::LengthMismatch {
             what: "uniforms vs remainder draws",
             expected: m,
             got: uniforms.len(),
-        });
+        }
+        .into());
     }
     if m == 0 {
         return Ok(k);
