@@ -6,10 +6,9 @@ use crate::cloud::ParticleCloud;
 use crate::error::Result;
 use crate::gauss::{Density, first_non_finite, log_det_half, psd_factor, shifted, to_f64};
 use crate::pf::{
-    MIN_PARTICLES_PER_TASK, ParticleFiltering, PfConfig, StepSummary, log_likelihood,
+    MIN_PARTICLES_PER_TASK, ParticleFiltering, PfConfig, StepSummary, finish_step, log_likelihood,
     predict_clouds, propagate_one, step_noise, weigh_and_select,
 };
-use crate::weights::normalize_log_weights;
 use nalgebra::allocator::Allocator;
 use nalgebra::{Cholesky, DefaultAllocator, Dim, OMatrix, OVector, RealField};
 use rand::Rng;
@@ -551,7 +550,7 @@ where
         rng: &mut R,
     ) -> Result<StepSummary<T, D>> {
         let noise = step_noise(&self.cloud, self.observation.observation_dim(), z, rng)?;
-        let (n, count) = (self.cloud.dim(), self.cloud.len());
+        let n = self.cloud.dim();
         let this = &*self;
         let ukf = this.ukf_stage()?;
         let moved: Vec<Moved<T, D>> = this
@@ -572,30 +571,19 @@ where
             .collect();
         let (select, ess, lse) = weigh_and_select(&mut log_w, &self.config, rng)?;
         let fallbacks = moved.iter().filter(|m| m.fallback).count();
-        let (mut particles, mut covs): (Vec<_>, Vec<_>) =
-            moved.into_iter().map(|m| (m.x, m.p)).unzip();
-        let weighted = ParticleCloud::new(particles.clone(), log_w.clone())?;
-        let estimate = weighted.estimate();
-        let resampled = select.is_some();
-        if let Some(idx) = select {
-            particles = idx.iter().map(|&i| particles[i].clone()).collect();
+        let (particles, mut covs): (Vec<_>, Vec<_>) = moved.into_iter().map(|m| (m.x, m.p)).unzip();
+        if let Some(idx) = &select {
             covs = idx.iter().map(|&i| covs[i].clone()).collect();
-            log_w = vec![0.0; count];
-        }
-        let (ps, ws) = self.cloud.parts_mut();
-        *ps = particles;
-        *ws = log_w;
-        if resampled {
-            normalize_log_weights(ws)?;
         }
         self.covariances = covs;
-        Ok(StepSummary {
-            estimate,
-            ess,
-            resampled,
-            log_likelihood: if z.is_some() { lse } else { 0.0 },
+        finish_step(
+            &mut self.cloud,
+            particles,
+            log_w,
+            (select.as_deref(), ess, lse),
+            z.is_some(),
             fallbacks,
-        })
+        )
     }
 
     fn cloud(&self) -> &ParticleCloud<T, D> {

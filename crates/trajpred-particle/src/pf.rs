@@ -267,6 +267,47 @@ pub(crate) fn weigh_and_select<R: Rng + ?Sized>(
     Ok((Some(idx), ess, lse))
 }
 
+/// The end of a step, the same for both filters: the estimate of the moved particles under
+/// their new normalised `log_w`; then the particles (the ancestors in `select` when it is
+/// `Some`, with equal weights) become the cloud. Returns the step's summary, with the ESS
+/// and log-likelihood increment `lse` of [`weigh_and_select`] (the increment reported only
+/// when the step had an observation) and the count of `fallbacks`.
+pub(crate) fn finish_step<T, D>(
+    cloud: &mut ParticleCloud<T, D>,
+    mut particles: Vec<OVector<T, D>>,
+    mut log_w: Vec<f64>,
+    (select, ess, lse): (Option<&[usize]>, f64, f64),
+    observed: bool,
+    fallbacks: usize,
+) -> Result<StepSummary<T, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    let count = cloud.len();
+    let weighted = ParticleCloud::new(particles.clone(), log_w.clone())?;
+    let estimate = weighted.estimate();
+    let resampled = select.is_some();
+    if let Some(idx) = select {
+        particles = idx.iter().map(|&i| particles[i].clone()).collect();
+        log_w = vec![0.0; count];
+    }
+    let (ps, ws) = cloud.parts_mut();
+    *ps = particles;
+    *ws = log_w;
+    if resampled {
+        normalize_log_weights(ws)?;
+    }
+    Ok(StepSummary {
+        estimate,
+        ess,
+        resampled,
+        log_likelihood: if observed { lse } else { 0.0 },
+        fallbacks,
+    })
+}
+
 /// The bootstrap (sampling importance resampling) particle filter of Gordon et al.: propose
 /// from the transition, `x_k^i = f(x_(k-1)^i) + w`, `w ~ N(0, Q)` (a singular `Q`, such as
 /// the discrete white-noise model, is fine), weight by the likelihood
@@ -408,7 +449,7 @@ where
         rng: &mut R,
     ) -> Result<StepSummary<T, D>> {
         let noise = step_noise(&self.cloud, self.observation.observation_dim(), z, rng)?;
-        let (n, count) = (self.cloud.dim(), self.cloud.len());
+        let n = self.cloud.dim();
         let (tr, ob, lik, qf) = (
             &self.transition,
             &self.observation,
@@ -438,27 +479,15 @@ where
             .map(|(l, (_, ll))| l + ll)
             .collect();
         let (select, ess, lse) = weigh_and_select(&mut log_w, &self.config, rng)?;
-        let mut particles: Vec<OVector<T, D>> = moved.into_iter().map(|(x, _)| x).collect();
-        let weighted = ParticleCloud::new(particles.clone(), log_w.clone())?;
-        let estimate = weighted.estimate();
-        let resampled = select.is_some();
-        if let Some(idx) = select {
-            particles = idx.iter().map(|&i| particles[i].clone()).collect();
-            log_w = vec![0.0; count];
-        }
-        let (ps, ws) = self.cloud.parts_mut();
-        *ps = particles;
-        *ws = log_w;
-        if resampled {
-            normalize_log_weights(ws)?;
-        }
-        Ok(StepSummary {
-            estimate,
-            ess,
-            resampled,
-            log_likelihood: if z.is_some() { lse } else { 0.0 },
-            fallbacks: 0,
-        })
+        let particles: Vec<OVector<T, D>> = moved.into_iter().map(|(x, _)| x).collect();
+        finish_step(
+            &mut self.cloud,
+            particles,
+            log_w,
+            (select.as_deref(), ess, lse),
+            z.is_some(),
+            0,
+        )
     }
 
     fn cloud(&self) -> &ParticleCloud<T, D> {
