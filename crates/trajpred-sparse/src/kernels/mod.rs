@@ -140,7 +140,19 @@ fn dots_into<S: Simd>(
     }
 }
 
-struct Dots<'a> {
+/// Which kernel [`OverColumns`] runs over all the rows.
+#[derive(Clone, Copy)]
+enum ColumnKernel {
+    /// [`dots_into`]: `out[k] = x_{cols[k]} . v`.
+    Dots,
+    /// [`combine_into`]: `out = sum_k v[k] x_{cols[k]}`.
+    Combine,
+}
+
+/// A kernel over the columns `cols` of the column-major `data` (`n` rows) with one operand
+/// vector `v`, dispatched to the CPU's SIMD: the frame [`dots`] and [`combine`] share.
+struct OverColumns<'a> {
+    kernel: ColumnKernel,
     data: &'a [f64],
     n: usize,
     cols: &'a [usize],
@@ -148,18 +160,22 @@ struct Dots<'a> {
     out: &'a mut [f64],
 }
 
-impl WithSimd for Dots<'_> {
+impl WithSimd for OverColumns<'_> {
     type Output = ();
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) {
-        let Dots {
+        let OverColumns {
+            kernel,
             data,
             n,
             cols,
             v,
             out,
         } = self;
-        dots_into(simd, (data, n), cols, (0, n), v, out);
+        match kernel {
+            ColumnKernel::Dots => dots_into(simd, (data, n), cols, (0, n), v, out),
+            ColumnKernel::Combine => combine_into(simd, (data, n), cols, (0, n), v, out),
+        }
     }
 }
 
@@ -168,7 +184,8 @@ impl WithSimd for Dots<'_> {
 pub(crate) fn dots(data: &[f64], n: usize, cols: &[usize], v: &[f64], out: &mut [f64]) {
     debug_assert_eq!(v.len(), n);
     debug_assert_eq!(out.len(), cols.len());
-    arch().dispatch(Dots {
+    arch().dispatch(OverColumns {
+        kernel: ColumnKernel::Dots,
         data,
         n,
         cols,
@@ -179,14 +196,6 @@ pub(crate) fn dots(data: &[f64], n: usize, cols: &[usize], v: &[f64], out: &mut 
 
 // ---------------------------------------------------------------------------------------
 // X_S w
-
-struct Combine<'a> {
-    data: &'a [f64],
-    n: usize,
-    cols: &'a [usize],
-    w: &'a [f64],
-    out: &'a mut [f64],
-}
 
 /// `out = sum_k w[k] x_{cols[k]}[rows]` (`out.len()` = the number of rows).
 #[inline(always)]
@@ -227,21 +236,6 @@ fn combine_into<S: Simd>(
             }
         }
         k += m;
-    }
-}
-
-impl WithSimd for Combine<'_> {
-    type Output = ();
-    #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) {
-        let Combine {
-            data,
-            n,
-            cols,
-            w,
-            out,
-        } = self;
-        combine_into(simd, (data, n), cols, (0, n), w, out);
     }
 }
 
@@ -321,11 +315,12 @@ pub(crate) fn residual_dots(
 pub(crate) fn combine(data: &[f64], n: usize, cols: &[usize], w: &[f64], out: &mut [f64]) {
     debug_assert_eq!(out.len(), n);
     debug_assert_eq!(w.len(), cols.len());
-    arch().dispatch(Combine {
+    arch().dispatch(OverColumns {
+        kernel: ColumnKernel::Combine,
         data,
         n,
         cols,
-        w,
+        v: w,
         out,
     });
 }
