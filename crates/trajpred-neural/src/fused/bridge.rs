@@ -4,7 +4,7 @@
 use crate::error::{NeuralError, Result};
 use burn::backend::autodiff::checkpoint::strategy::NoCheckpointing;
 use burn::backend::autodiff::grads::Gradients;
-use burn::backend::autodiff::ops::{Backward, NodeGuard, OpsKind};
+use burn::backend::autodiff::ops::{Backward, NodeGuard, Ops, OpsKind};
 use burn::backend::flex::FlexTensor;
 use burn::backend::tensor::FloatTensor;
 use burn::backend::{Autodiff, Flex};
@@ -141,5 +141,38 @@ pub(crate) fn register(
 ) {
     if let Some(id) = parent {
         grads.register::<Flex>(*id, flex(grad, shape));
+    }
+}
+
+/// The backward step of a fused op of `N` inputs: the output gradient of the op's node
+/// (`what` names it in errors) goes to `compute` with the op's state and which inputs need a
+/// gradient; each input's gradient (of the shape `shapes` gives it) is registered for its
+/// node. An error of `compute` (an internal inconsistency, not reachable with the shapes
+/// checked in the forward pass) registers NaN gradients, which the training loop reports
+/// as divergence.
+pub(crate) fn backward_step<S, const N: usize>(
+    ops: Ops<S, N>,
+    grads: &mut Gradients,
+    what: &str,
+    shapes: impl FnOnce(&S) -> [Vec<usize>; N],
+    compute: impl FnOnce(&S, &[f32], [bool; N]) -> Result<[Vec<f32>; N]>,
+) {
+    let Ops {
+        parents,
+        node,
+        state,
+    } = ops;
+    let grad: FlexTensor = grads.consume::<Flex>(&node);
+    let ids = parents.each_ref().map(|p| p.as_ref().map(|n| n.id));
+    let shapes = shapes(&state);
+    let result =
+        values(&grad, what).and_then(|g| compute(&state, &g, ids.each_ref().map(Option::is_some)));
+    let parts = result.unwrap_or_else(|_| {
+        shapes
+            .each_ref()
+            .map(|shape| vec![f32::NAN; shape.iter().product()])
+    });
+    for ((id, g), shape) in ids.iter().zip(parts).zip(&shapes) {
+        register(grads, id.as_ref(), g, shape);
     }
 }

@@ -577,38 +577,26 @@ impl Backward<Flex, 2> for SequenceBackward {
     type State = State;
 
     fn backward(self, ops: Ops<State, 2>, grads: &mut Gradients, _: &mut Checkpointer) {
-        let Ops {
-            parents,
-            node,
-            state,
-        } = ops;
-        let grad: FlexTensor = grads.consume::<Flex>(&node);
-        let [z_id, p_id] = parents.each_ref().map(|p| p.as_ref().map(|n| n.id));
-        let (batch, c, d) = (state.cache.batch, state.cache.c, state.spec.d);
-        let result = bridge::values(&grad, "KFU output gradient").and_then(|g| {
-            backward(
-                &state.spec,
-                &state.cache,
-                &state.z,
-                &state.params,
-                &g,
-                z_id.is_some(),
-            )
-        });
-        // An internal inconsistency (not reachable with the shapes checked in the forward
-        // pass) leaves NaN gradients, which the training loop reports as divergence.
-        let g = result.unwrap_or_else(|_| Grads {
-            params: vec![f32::NAN; state.params.len()],
-            z: Some(vec![f32::NAN; batch * c * d]),
-        });
-        bridge::register(
+        bridge::backward_step(
+            ops,
             grads,
-            z_id.as_ref(),
-            g.z.unwrap_or_default(),
-            &[batch, c, d],
+            "KFU output gradient",
+            |state| {
+                let (batch, c, d) = (state.cache.batch, state.cache.c, state.spec.d);
+                [vec![batch, c, d], vec![state.params.len()]]
+            },
+            |state, g, [need_z, _]| {
+                let g = backward(
+                    &state.spec,
+                    &state.cache,
+                    &state.z,
+                    &state.params,
+                    g,
+                    need_z,
+                )?;
+                Ok([g.z.unwrap_or_default(), g.params])
+            },
         );
-        let n = g.params.len();
-        bridge::register(grads, p_id.as_ref(), g.params, &[n]);
     }
 }
 

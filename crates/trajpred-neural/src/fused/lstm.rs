@@ -265,50 +265,29 @@ impl Backward<Flex, 4> for LayerBackward {
     type State = State;
 
     fn backward(self, ops: Ops<State, 4>, grads: &mut Gradients, _: &mut Checkpointer) {
-        let Ops {
-            parents,
-            node,
-            state,
-        } = ops;
-        let grad: FlexTensor = grads.consume::<Flex>(&node);
-        let Dims {
-            batch,
-            steps,
-            input,
-            hidden,
-        } = state.cache.dims;
-        let ids = parents.each_ref().map(|p| p.as_ref().map(|n| n.id));
-        let shapes: [Vec<usize>; 4] = [
-            vec![batch, steps, input],
-            vec![input, 4 * hidden],
-            vec![4 * hidden],
-            vec![hidden, 4 * hidden],
-        ];
-        let result = bridge::values(&grad, "LSTM output gradient").and_then(|dh| {
-            backward(
-                &state.cache,
-                &state.w_ih,
-                &state.w_hh,
-                &dh,
-                ids[0].is_some(),
-            )
-        });
-        // An internal inconsistency (not reachable with the shapes checked in the forward
-        // pass) leaves NaN gradients, which the training loop reports as divergence.
-        let g = result.unwrap_or_else(|_| {
-            let nan = |n: usize| vec![f32::NAN; n];
-            Grads {
-                dx: Some(nan(batch * steps * input)),
-                dw_ih: nan(input * 4 * hidden),
-                db: nan(4 * hidden),
-                dw_hh: nan(hidden * 4 * hidden),
-            }
-        });
-        let dx = g.dx.unwrap_or_default();
-        let parts = [dx, g.dw_ih, g.db, g.dw_hh];
-        for ((id, grad), shape) in ids.iter().zip(parts).zip(&shapes) {
-            bridge::register(grads, id.as_ref(), grad, shape);
-        }
+        bridge::backward_step(
+            ops,
+            grads,
+            "LSTM output gradient",
+            |state| {
+                let Dims {
+                    batch,
+                    steps,
+                    input,
+                    hidden,
+                } = state.cache.dims;
+                [
+                    vec![batch, steps, input],
+                    vec![input, 4 * hidden],
+                    vec![4 * hidden],
+                    vec![hidden, 4 * hidden],
+                ]
+            },
+            |state, dh, [need_x, ..]| {
+                let g = backward(&state.cache, &state.w_ih, &state.w_hh, dh, need_x)?;
+                Ok([g.dx.unwrap_or_default(), g.dw_ih, g.db, g.dw_hh])
+            },
+        );
     }
 }
 
