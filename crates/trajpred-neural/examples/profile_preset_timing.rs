@@ -1,7 +1,7 @@
 //! Times a few epochs of every preset at the papers' data sizes and extrapolates to the full
 //! epoch counts, so the reproduction can budget its run time.
 //!
-//! `cargo run --release -p trajpred-neural --example preset_timing -- [epochs]`
+//! `cargo run --release -p trajpred-neural --example profile_preset_timing -- [epochs]`
 
 use std::time::Instant;
 use trajpred_core::Trajectory;
