@@ -9,10 +9,6 @@
 use super::bridge;
 use super::{Mat, Real, add_column_sums, cell_backward, cell_forward, gemm};
 use crate::error::{NeuralError, Result};
-use burn::backend::Flex;
-use burn::backend::autodiff::checkpoint::base::Checkpointer;
-use burn::backend::autodiff::grads::Gradients;
-use burn::backend::autodiff::ops::{Backward, Ops};
 use burn::backend::flex::FlexTensor;
 use burn::tensor::Tensor;
 
@@ -257,37 +253,28 @@ pub(crate) struct State {
     w_hh: Vec<f32>,
 }
 
-/// The autodiff node of a fused LSTM layer (parents: `x`, `W_ih`, `b`, `W_hh`).
-#[derive(Debug)]
-struct LayerBackward;
+/// A fused LSTM layer's inputs: `x`, `W_ih`, `b`, `W_hh`.
+impl bridge::FusedState<4> for State {
+    const WHAT: &'static str = "LSTM output gradient";
 
-impl Backward<Flex, 4> for LayerBackward {
-    type State = State;
+    fn shapes(&self) -> [Vec<usize>; 4] {
+        let Dims {
+            batch,
+            steps,
+            input,
+            hidden,
+        } = self.cache.dims;
+        [
+            vec![batch, steps, input],
+            vec![input, 4 * hidden],
+            vec![4 * hidden],
+            vec![hidden, 4 * hidden],
+        ]
+    }
 
-    fn backward(self, ops: Ops<State, 4>, grads: &mut Gradients, _: &mut Checkpointer) {
-        bridge::backward_step(
-            ops,
-            grads,
-            "LSTM output gradient",
-            |state| {
-                let Dims {
-                    batch,
-                    steps,
-                    input,
-                    hidden,
-                } = state.cache.dims;
-                [
-                    vec![batch, steps, input],
-                    vec![input, 4 * hidden],
-                    vec![4 * hidden],
-                    vec![hidden, 4 * hidden],
-                ]
-            },
-            |state, dh, [need_x, ..]| {
-                let g = backward(&state.cache, &state.w_ih, &state.w_hh, dh, need_x)?;
-                Ok([g.dx.unwrap_or_default(), g.dw_ih, g.db, g.dw_hh])
-            },
-        );
+    fn gradients(&self, dh: &[f32], [need_x, ..]: [bool; 4]) -> Result<[Vec<f32>; 4]> {
+        let g = backward(&self.cache, &self.w_ih, &self.w_hh, dh, need_x)?;
+        Ok([g.dx.unwrap_or_default(), g.dw_ih, g.db, g.dw_hh])
     }
 }
 
@@ -332,5 +319,11 @@ pub(crate) fn layer(
             },
         ))
     };
-    bridge::apply(LayerBackward, prims, &shape, "fused LSTM", run)
+    bridge::apply(
+        bridge::FusedBackward::<State>::new(),
+        prims,
+        &shape,
+        "fused LSTM",
+        run,
+    )
 }
