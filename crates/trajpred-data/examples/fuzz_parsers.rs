@@ -406,8 +406,9 @@ pub fn mutate(rng: &mut ChaCha8Rng, input: &[u8], other: &[u8]) -> Vec<u8> {
     v
 }
 
-/// The option sets inputs are parsed with (default, strict, gap splitting, small limits).
-pub fn option_sets() -> Vec<LoadOptions> {
+/// The option sets the property tests (`tests/robustness.rs`) parse with too: default,
+/// strict, gap splitting.
+pub fn base_option_sets() -> Vec<LoadOptions> {
     vec![
         LoadOptions::default(),
         LoadOptions {
@@ -420,14 +421,20 @@ pub fn option_sets() -> Vec<LoadOptions> {
             max_gap: Some(1.0),
             ..LoadOptions::tdrive()
         },
-        LoadOptions {
-            max_line_bytes: 4096,
-            max_track_points: 20,
-            max_total_points: 40,
-            max_json_bytes: 8192,
-            ..LoadOptions::geolife()
-        },
     ]
+}
+
+/// The option sets inputs are parsed with: [`base_option_sets`] and small limits.
+pub fn option_sets() -> Vec<LoadOptions> {
+    let mut sets = base_option_sets();
+    sets.push(LoadOptions {
+        max_line_bytes: 4096,
+        max_track_points: 20,
+        max_total_points: 40,
+        max_json_bytes: 8192,
+        ..LoadOptions::geolife()
+    });
+    sets
 }
 
 /// What one execution gave.
@@ -629,21 +636,20 @@ pub fn fuzz_with(
         let out = catch_unwind(AssertUnwindSafe(|| run(s.target, &input, o, &scratch)));
         stats.executions += 1;
         let fam = s.target.family();
+        // saves the input of a finding (`kind` `violation` or `panic`, with what went wrong)
+        // and returns the line that lists it
+        let keep = |kind: &str, why: &str| {
+            let name = format!("{kind}-{seed}-{exec}-{:?}", s.target);
+            let note = format!("{why}\nseed input {}\n{o:?}\n", s.name);
+            let p = save(dir, &name, &input, &note);
+            format!("{kind} {why} ({:?}, {p})", s.target)
+        };
         let key = match out {
             Ok(Outcome::Ok) => format!("{fam} Ok"),
             Ok(Outcome::Err(l)) => format!("{fam} Err({l})"),
             Ok(Outcome::Violation(why)) => {
                 stats.violations += 1;
-                let name = format!("violation-{seed}-{exec}-{:?}", s.target);
-                let p = save(
-                    dir,
-                    &name,
-                    &input,
-                    &format!("{why}\nseed input {}\n{o:?}\n", s.name),
-                );
-                stats
-                    .findings
-                    .push(format!("violation {why} ({:?}, {p})", s.target));
+                stats.findings.push(keep("violation", &why));
                 format!("{fam} Violation")
             }
             Err(_) => {
@@ -651,16 +657,7 @@ pub fn fuzz_with(
                 let msg = LAST_PANIC
                     .with(|p| p.borrow_mut().take())
                     .unwrap_or_default();
-                let name = format!("panic-{seed}-{exec}-{:?}", s.target);
-                let p = save(
-                    dir,
-                    &name,
-                    &input,
-                    &format!("{msg}\nseed input {}\n{o:?}\n", s.name),
-                );
-                stats
-                    .findings
-                    .push(format!("panic {msg} ({:?}, {p})", s.target));
+                stats.findings.push(keep("panic", &msg));
                 format!("{fam} PANIC")
             }
         };

@@ -5,6 +5,12 @@
 use proptest::prelude::*;
 use trajpred_data::{Error, LoadOptions, LoadReport, Track, adsb, csvfile, geolife, tdrive};
 
+#[allow(dead_code)]
+#[path = "../examples/fuzz_parsers.rs"]
+mod fuzz;
+
+use fuzz::base_option_sets as option_sets;
+
 const PLT: &str = "Geolife trajectory\r\nWGS 84\r\nAltitude is in Feet\r\nReserved 3\r\n0,2,255,My Track,0,0,2,8421376\r\n0\r\n39.984702,116.318417,0,492,39744.1201851852,2008-10-23,02:53:04\r\n39.984683,116.318450,0,492,39744.1202546296,2008-10-23,02:53:10\r\n39.984686,116.318417,0,-777,39744.1202546296,2008-10-23,02:53:16\r\n";
 const TDRIVE: &str = "7,2008-02-02 13:30:49,116.76038,39.79758\n7,2008-02-02 13:35:49,116.76135,39.79712\n7,2008-02-02 15:55:49,116.70000,39.80000\n";
 const ADSB: &str = r#"[{"timestamp":1527693698000,"icao24":"484506","latitude":52.3239,"longitude":4.7394,"callsign":"TRA051","altitude":224.0},{"timestamp":1527693699000,"icao24":"484506","latitude":52.3251,"longitude":4.7396,"callsign":"TRA051","altitude":null}]"#;
@@ -14,19 +20,16 @@ const CSV_LL: &str = "t,lat,lon,alt\n0,39.9,116.4,5\n1,39.9001,116.4001,6\n";
 const LABELS: &str =
     "Start Time\tEnd Time\tTransportation Mode\n2008/10/23 02:53:04\t2008/10/23 02:53:40\tbus\n";
 
-fn option_sets() -> Vec<LoadOptions> {
-    vec![
-        LoadOptions::default(),
-        LoadOptions {
-            altitude: true,
-            strict: true,
-            ..LoadOptions::adsb()
-        },
-        LoadOptions {
-            min_points: 2,
-            max_gap: Some(1.0),
-            ..LoadOptions::tdrive()
-        },
+/// A track parser with its fixed file name and id: `(input, options, report)`.
+type Parse = fn(&[u8], &LoadOptions, &mut LoadReport) -> Result<Vec<Track>, Error>;
+
+/// Every track parser, each with whether it reads JSON (its errors number records, not lines).
+fn parsers() -> [(Parse, bool); 4] {
+    [
+        (|i, o, r| geolife::parse_plt(i, "f", "u/f", o, r), false),
+        (|i, o, r| tdrive::parse(i, "f", o, r), false),
+        (|i, o, r| adsb::parse_json(i, "f", o, r), true),
+        (|i, o, r| csvfile::parse(i, "f", o, r), false),
     ]
 }
 
@@ -71,18 +74,11 @@ fn check(
 
 fn run_all(input: &[u8]) -> Result<(), TestCaseError> {
     for opts in option_sets() {
-        let mut r = LoadReport::new();
-        let res = geolife::parse_plt(input, "f", "u/f", &opts, &mut r);
-        check(res, &r, input, false)?;
-        let mut r = LoadReport::new();
-        let res = tdrive::parse(input, "f", &opts, &mut r);
-        check(res, &r, input, false)?;
-        let mut r = LoadReport::new();
-        let res = adsb::parse_json(input, "f", &opts, &mut r);
-        check(res, &r, input, true)?;
-        let mut r = LoadReport::new();
-        let res = csvfile::parse(input, "f", &opts, &mut r);
-        check(res, &r, input, false)?;
+        for (parse, json) in parsers() {
+            let mut r = LoadReport::new();
+            let res = parse(input, &opts, &mut r);
+            check(res, &r, input, json)?;
+        }
         match geolife::parse_labels(input, "f", opts.strict) {
             Ok((_, r)) => prop_assert_eq!(r.records_read, r.points_kept + r.skipped_total()),
             Err(Error::Parse { line, .. }) => prop_assert!(line >= 1),
@@ -195,48 +191,19 @@ fn unmutated_bases_parse_cleanly() {
         strict: true,
         ..LoadOptions::default()
     };
-    let mut r = LoadReport::new();
-    assert_eq!(
-        geolife::parse_plt(PLT.as_bytes(), "f", "u/f", &o, &mut r).unwrap()[0]
-            .trajectory
-            .len(),
-        3
-    );
-    let mut r = LoadReport::new();
-    assert_eq!(
-        tdrive::parse(TDRIVE.as_bytes(), "f", &o, &mut r).unwrap()[0]
-            .trajectory
-            .len(),
-        3
-    );
-    let mut r = LoadReport::new();
-    assert_eq!(
-        adsb::parse_json(ADSB.as_bytes(), "f", &o, &mut r).unwrap()[0]
-            .trajectory
-            .len(),
-        2
-    );
-    let mut r = LoadReport::new();
-    assert_eq!(
-        adsb::parse_json(ADSB_COLS.as_bytes(), "f", &o, &mut r).unwrap()[0]
-            .trajectory
-            .len(),
-        1
-    );
-    let mut r = LoadReport::new();
-    assert_eq!(
-        csvfile::parse(CSV_XY.as_bytes(), "f", &o, &mut r).unwrap()[0]
-            .trajectory
-            .len(),
-        3
-    );
-    let mut r = LoadReport::new();
-    assert_eq!(
-        csvfile::parse(CSV_LL.as_bytes(), "f", &o, &mut r).unwrap()[0]
-            .trajectory
-            .len(),
-        2
-    );
+    // (input, index in parsers(), points of its first track)
+    for (input, k, points) in [
+        (PLT, 0, 3),
+        (TDRIVE, 1, 3),
+        (ADSB, 2, 2),
+        (ADSB_COLS, 2, 1),
+        (CSV_XY, 3, 3),
+        (CSV_LL, 3, 2),
+    ] {
+        let mut r = LoadReport::new();
+        let tracks = parsers()[k].0(input.as_bytes(), &o, &mut r).unwrap();
+        assert_eq!(tracks[0].trajectory.len(), points, "{input}");
+    }
     assert_eq!(
         geolife::parse_labels(LABELS.as_bytes(), "f", true)
             .unwrap()

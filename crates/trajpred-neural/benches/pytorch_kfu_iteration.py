@@ -24,14 +24,11 @@ wall times (time.perf_counter) of `--repeat` iterations are printed.
 """
 
 import argparse
-import json
-import math
-import statistics
-import sys
-import time
 
 import torch
 from torch import nn
+
+from torch_timing import add_common_args, emit, set_threads, spread, summary, timed
 
 
 def data(n=200, batch=16, noise=0.1):
@@ -89,13 +86,9 @@ class Kfu(nn.Module):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--threads", type=int, default=1, help="torch.set_num_threads; 0 = default")
-    ap.add_argument("--warmup", type=int, default=3)
-    ap.add_argument("--repeat", type=int, default=10)
-    ap.add_argument("--json", action="store_true", help="print one JSON line instead of text")
+    add_common_args(ap, repeat=10)
     a = ap.parse_args()
-    if a.threads > 0:
-        torch.set_num_threads(a.threads)
+    set_threads(a)
     torch.manual_seed(0)
     z = data()
     net = Kfu()
@@ -104,44 +97,30 @@ def main():
     opt = torch.optim.Adam(
         [{"params": rest, "lr": 1e-4}, {"params": noise, "lr": 1e-2}], eps=1e-8
     )
-    times, losses = [], []
-    for i in range(a.warmup + a.repeat):
-        t0 = time.perf_counter()
+
+    def iteration():
         opt.zero_grad(set_to_none=True)
         loss = nn.functional.mse_loss(net(z), z[:, 1:])
         loss.backward()
         opt.step()
-        value = loss.item()
-        dt = time.perf_counter() - t0
-        if not math.isfinite(value):
-            sys.exit(f"loss diverged: {value}")
-        losses.append(value)
-        if i >= a.warmup:
-            times.append(dt)
-    q = statistics.quantiles(times, n=4, method="inclusive")
+        return loss.item()
+
+    times, losses = timed(iteration, a.warmup, a.repeat)
     res = {
         "impl": "torch",
         "workload": "kfu",
         "torch": torch.__version__,
         "threads": torch.get_num_threads(),
         "repeat": a.repeat,
-        "median_s": statistics.median(times),
-        "p25_s": q[0],
-        "p75_s": q[2],
-        "min_s": min(times),
-        "max_s": max(times),
-        "first_loss": losses[0],
-        "last_loss": losses[-1],
+        **summary(times, losses),
     }
-    if a.json:
-        print(json.dumps(res))
-    else:
-        print(
-            f"torch {res['torch']}, {res['threads']} thread(s): median {res['median_s']:.4f} s/iter "
-            f"[p25 {res['p25_s']:.4f}, p75 {res['p75_s']:.4f}; min {res['min_s']:.4f}, "
-            f"max {res['max_s']:.4f}] over {a.repeat} iterations after {a.warmup} warm-up; "
-            f"loss {losses[0]:.4f} -> {losses[-1]:.4f}"
-        )
+    emit(
+        res,
+        a.json,
+        f"torch {res['torch']}, {res['threads']} thread(s): {spread(res, 'iter')} "
+        f"over {a.repeat} iterations after {a.warmup} warm-up; "
+        f"loss {losses[0]:.4f} -> {losses[-1]:.4f}",
+    )
 
 
 if __name__ == "__main__":

@@ -25,14 +25,11 @@ RNN kernel does).
 """
 
 import argparse
-import json
-import math
-import statistics
-import sys
-import time
 
 import torch
 from torch import nn
+
+from torch_timing import add_common_args, emit, set_threads, spread, summary, timed
 
 
 def data(n=800, m=10):
@@ -79,15 +76,11 @@ def epoch(net, opt, xs, ys, batch, gen):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--threads", type=int, default=1, help="torch.set_num_threads; 0 = default")
-    ap.add_argument("--warmup", type=int, default=3)
-    ap.add_argument("--repeat", type=int, default=15)
+    add_common_args(ap, repeat=15)
     ap.add_argument("--batch", type=int, default=16)
     ap.add_argument("--no-mkldnn", action="store_true")
-    ap.add_argument("--json", action="store_true", help="print one JSON line instead of text")
     a = ap.parse_args()
-    if a.threads > 0:
-        torch.set_num_threads(a.threads)
+    set_threads(a)
     if a.no_mkldnn:
         torch.backends.mkldnn.enabled = False
     torch.manual_seed(0)
@@ -95,17 +88,14 @@ def main():
     xs, ys = data()
     net = Net()
     opt = torch.optim.Adam(net.parameters(), lr=1e-3, eps=1e-8)
-    times, losses = [], []
-    for i in range(a.warmup + a.repeat):
-        t0 = time.perf_counter()
+    batches = 0
+
+    def one_epoch():
+        nonlocal batches
         loss, batches = epoch(net, opt, xs, ys, a.batch, gen)
-        dt = time.perf_counter() - t0
-        if not math.isfinite(loss):
-            sys.exit(f"loss diverged: {loss}")
-        losses.append(loss)
-        if i >= a.warmup:
-            times.append(dt)
-    q = statistics.quantiles(times, n=4, method="inclusive")
+        return loss
+
+    times, losses = timed(one_epoch, a.warmup, a.repeat)
     res = {
         "impl": "torch",
         "workload": "lstm",
@@ -115,24 +105,15 @@ def main():
         "batches_per_epoch": batches,
         "warmup": a.warmup,
         "repeat": a.repeat,
-        "median_s": statistics.median(times),
-        "p25_s": q[0],
-        "p75_s": q[2],
-        "min_s": min(times),
-        "max_s": max(times),
-        "first_loss": losses[0],
-        "last_loss": losses[-1],
+        **summary(times, losses),
     }
-    if a.json:
-        print(json.dumps(res))
-    else:
-        print(
-            f"torch {res['torch']}, {res['threads']} thread(s), mkldnn {res['mkldnn']}, "
-            f"{batches} batches/epoch: median {res['median_s']:.4f} s/epoch "
-            f"[p25 {res['p25_s']:.4f}, p75 {res['p75_s']:.4f}; min {res['min_s']:.4f}, "
-            f"max {res['max_s']:.4f}] over {a.repeat} epochs "
-            f"after {a.warmup} warm-up; loss {losses[0]:.4f} -> {losses[-1]:.4f}"
-        )
+    emit(
+        res,
+        a.json,
+        f"torch {res['torch']}, {res['threads']} thread(s), mkldnn {res['mkldnn']}, "
+        f"{batches} batches/epoch: {spread(res, 'epoch')} over {a.repeat} epochs "
+        f"after {a.warmup} warm-up; loss {losses[0]:.4f} -> {losses[-1]:.4f}",
+    )
 
 
 if __name__ == "__main__":

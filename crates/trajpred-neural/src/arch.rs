@@ -76,6 +76,23 @@ pub(crate) fn check_sizes(name: &'static str, sizes: &[usize], need_one: bool) -
     Ok(())
 }
 
+/// Layers of the widths `sizes`, in order, the first taking `d_in` inputs: `make(d, h)`
+/// builds a layer from width `d` to `h`. Returns the layers and the last width (`d_in`
+/// when `sizes` is empty).
+fn chain<L>(
+    d_in: usize,
+    sizes: &[usize],
+    mut make: impl FnMut(usize, usize) -> L,
+) -> (Vec<L>, usize) {
+    let mut layers = Vec::with_capacity(sizes.len());
+    let mut d = d_in;
+    for &h in sizes {
+        layers.push(make(d, h));
+        d = h;
+    }
+    (layers, d)
+}
+
 /// Fully connected layers with an activation, then a linear output layer.
 #[derive(Module, Debug)]
 pub struct Head {
@@ -93,12 +110,7 @@ impl Head {
         activation: Activation,
         device: &Device,
     ) -> Self {
-        let mut hidden = Vec::with_capacity(sizes.len());
-        let mut d = d_in;
-        for &h in sizes {
-            hidden.push(LinearConfig::new(d, h).init(device));
-            d = h;
-        }
+        let (hidden, d) = chain(d_in, sizes, |d, h| LinearConfig::new(d, h).init(device));
         Head {
             hidden,
             out: LinearConfig::new(d, outputs).init(device),
@@ -181,6 +193,28 @@ pub struct RecurrentLayers {
     pub fc: Vec<usize>,
     /// Activation of the fully connected hidden layers.
     pub activation: Activation,
+}
+
+impl RecurrentLayers {
+    /// At least one recurrent layer, and no layer of width 0.
+    fn validate(&self) -> Result<()> {
+        check_sizes("layers", &self.layers, true)?;
+        check_sizes("fc", &self.fc, false)
+    }
+
+    /// The recurrent layers (`make(d, h)` builds one from width `d` to `h`), the first on
+    /// `features` inputs, then the head on the last one's hidden state, in that order.
+    fn build<L>(
+        &self,
+        features: usize,
+        outputs: usize,
+        device: &Device,
+        make: impl FnMut(usize, usize) -> L,
+    ) -> (Vec<L>, Head) {
+        let (layers, d) = chain(features, &self.layers, make);
+        let head = Head::new(d, &self.fc, outputs, self.activation, device);
+        (layers, head)
+    }
 }
 
 impl Default for RecurrentLayers {
@@ -374,20 +408,13 @@ impl Architecture for RnnArch {
     type Net = RnnStack;
     const NAME: &'static str = "rnn";
     fn validate(&self) -> Result<()> {
-        check_sizes("layers", &self.0.layers, true)?;
-        check_sizes("fc", &self.0.fc, false)
+        self.0.validate()
     }
     fn build(&self, features: usize, _window: usize, outputs: usize, device: &Device) -> RnnStack {
-        let mut d = features;
-        let mut layers = Vec::new();
-        for &h in &self.0.layers {
-            layers.push(RnnConfig::new(d, h, true).init(device));
-            d = h;
-        }
-        RnnStack {
-            layers,
-            head: Head::new(d, &self.0.fc, outputs, self.0.activation, device),
-        }
+        let (layers, head) = self.0.build(features, outputs, device, |d, h| {
+            RnnConfig::new(d, h, true).init(device)
+        });
+        RnnStack { layers, head }
     }
     fn forward(&self, net: &RnnStack, mut x: Tensor<3>) -> Tensor<2> {
         let [b, _, _] = x.dims();
@@ -409,19 +436,15 @@ impl Architecture for LstmArch {
     type Net = LstmStack;
     const NAME: &'static str = "lstm";
     fn validate(&self) -> Result<()> {
-        check_sizes("layers", &self.0.layers, true)?;
-        check_sizes("fc", &self.0.fc, false)
+        self.0.validate()
     }
     fn build(&self, features: usize, _window: usize, outputs: usize, device: &Device) -> LstmStack {
-        let mut d = features;
-        let mut layers = Vec::new();
-        for &h in &self.0.layers {
-            layers.push(FusedLstm::new(d, h, device));
-            d = h;
-        }
+        let (layers, head) = self.0.build(features, outputs, device, |d, h| {
+            FusedLstm::new(d, h, device)
+        });
         LstmStack {
             layers,
-            head: Head::new(d, &self.0.fc, outputs, self.0.activation, device),
+            head,
             fused: true,
         }
     }

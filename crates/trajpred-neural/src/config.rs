@@ -106,52 +106,23 @@ impl TrainConfig {
         }
     }
 
-    /// Turns the fused LSTM / KFU ops on or off (off: burn's per-operation autodiff).
-    pub fn with_fused(mut self, fused: bool) -> Self {
-        self.fused = fused;
-        self
-    }
-
-    /// Sets the number of epochs.
-    pub fn with_epochs(mut self, epochs: usize) -> Self {
-        self.epochs = epochs;
-        self
-    }
-
-    /// Sets the batch size.
-    pub fn with_batch_size(mut self, batch_size: usize) -> Self {
-        self.batch_size = batch_size;
-        self
-    }
-
-    /// Sets the learning rate of the network weights.
-    pub fn with_learning_rate(mut self, learning_rate: f64) -> Self {
-        self.learning_rate = learning_rate;
-        self
-    }
-
-    /// Sets the optimizer.
-    pub fn with_optimizer(mut self, optimizer: Optimizer) -> Self {
-        self.optimizer = optimizer;
-        self
-    }
-
-    /// Sets the seed.
-    pub fn with_seed(mut self, seed: u64) -> Self {
-        self.seed = seed;
-        self
-    }
-
-    /// Turns on early stopping.
-    pub fn with_early_stopping(mut self, early_stopping: EarlyStopping) -> Self {
-        self.early_stopping = Some(early_stopping);
-        self
-    }
-
-    /// Clips the global gradient norm.
-    pub fn with_grad_clip_norm(mut self, norm: f64) -> Self {
-        self.grad_clip_norm = Some(norm);
-        self
+    setters! {
+        /// Turns the fused LSTM / KFU ops on or off (off: burn's per-operation autodiff).
+        with_fused(fused: bool) => self.fused = fused;
+        /// Sets the number of epochs.
+        with_epochs(epochs: usize) => self.epochs = epochs;
+        /// Sets the batch size.
+        with_batch_size(batch_size: usize) => self.batch_size = batch_size;
+        /// Sets the learning rate of the network weights.
+        with_learning_rate(learning_rate: f64) => self.learning_rate = learning_rate;
+        /// Sets the optimizer.
+        with_optimizer(optimizer: Optimizer) => self.optimizer = optimizer;
+        /// Sets the seed.
+        with_seed(seed: u64) => self.seed = seed;
+        /// Turns on early stopping.
+        with_early_stopping(early_stopping: EarlyStopping) => self.early_stopping = Some(early_stopping);
+        /// Clips the global gradient norm.
+        with_grad_clip_norm(norm: f64) => self.grad_clip_norm = Some(norm);
     }
 
     /// Checks every field.

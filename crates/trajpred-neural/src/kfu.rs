@@ -11,7 +11,8 @@ use crate::error::{NeuralError, Result};
 use crate::fused::{self, kfu::Spec};
 use crate::persist;
 use crate::train::{
-    LoopSpec, Standardizer, XavierZeroBias, check_finite, device, mse, read, rng, train_loop,
+    LoopSpec, Standardizer, XavierZeroBias, check_finite, common_dim, device, mse, read, rng,
+    train_loop,
 };
 use burn::lr_scheduler::module_lr_scheduler::ModuleLrScheduler;
 use burn::module::{Module, Param, ParamGroup};
@@ -459,19 +460,7 @@ impl KfuLstmNet {
         truth: Option<&[Trajectory]>,
         progress: &mut dyn FnMut(&EpochReport),
     ) -> Result<&TrainReport> {
-        let dim = observed
-            .first()
-            .map(Trajectory::dim)
-            .ok_or(NeuralError::NoTrainingData {
-                what: "no training trajectories",
-            })?;
-        if let Some(t) = observed.iter().find(|t| t.dim() != dim) {
-            return Err(NeuralError::DimensionMismatch {
-                what: "training trajectory axes",
-                expected: dim,
-                got: t.dim(),
-            });
-        }
+        let dim = common_dim(observed)?;
         let shortest = observed.iter().map(Trajectory::len).min().unwrap_or(0);
         if shortest < 3 {
             return Err(NeuralError::TooShort {

@@ -2,6 +2,22 @@
 #![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 
+/// Builder setters, written once: each `name(arg: Type) => self.field = value;` becomes
+/// `pub fn name(mut self, arg: Type) -> Self` that stores `value` in `field` and returns
+/// `self` for chaining (its doc comment goes with it). The values are checked when the
+/// settings are used (`validate`), not here.
+macro_rules! setters {
+    ($($(#[$doc:meta])* $name:ident($arg:ident: $ty:ty) => self.$field:ident = $value:expr;)*) => {
+        $(
+            $(#[$doc])*
+            pub fn $name(mut self, $arg: $ty) -> Self {
+                self.$field = $value;
+                self
+            }
+        )*
+    };
+}
+
 pub use burn;
 
 pub mod arch;

@@ -13,6 +13,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
+use trajpred_core::Trajectory;
 
 /// The CPU device every model trains on: burn's pure-Rust `flex` backend with autodiff.
 pub(crate) fn device() -> Device {
@@ -254,6 +255,25 @@ pub(crate) fn train_loop<N: Module>(
         net = b;
     }
     Ok((net, report))
+}
+
+/// The number of axes every training trajectory shares. Errors: [`NeuralError::NoTrainingData`]
+/// for none, [`NeuralError::DimensionMismatch`] naming the first that differs from the first.
+pub(crate) fn common_dim(train: &[Trajectory]) -> Result<usize> {
+    let dim = train
+        .first()
+        .map(Trajectory::dim)
+        .ok_or(NeuralError::NoTrainingData {
+            what: "no training trajectories",
+        })?;
+    if let Some(t) = train.iter().find(|t| t.dim() != dim) {
+        return Err(NeuralError::DimensionMismatch {
+            what: "training trajectory axes",
+            expected: dim,
+            got: t.dim(),
+        });
+    }
+    Ok(dim)
 }
 
 /// Checks that every value of a raw series is finite.

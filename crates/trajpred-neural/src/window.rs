@@ -7,7 +7,8 @@ use crate::config::{Activation, AxisMode, EpochReport, Optimizer, TrainConfig, T
 use crate::error::{NeuralError, Result};
 use crate::persist;
 use crate::train::{
-    LoopSpec, Standardizer, XavierZeroBias, check_finite, device, mse, read, rng, train_loop,
+    LoopSpec, Standardizer, XavierZeroBias, check_finite, common_dim, device, mse, read, rng,
+    train_loop,
 };
 use burn::lr_scheduler::module_lr_scheduler::ModuleLrScheduler;
 use burn::module::Module;
@@ -268,19 +269,7 @@ impl<A: Architecture> WindowNet<A> {
         targets: Option<&[Trajectory]>,
         progress: &mut dyn FnMut(&EpochReport),
     ) -> Result<&[TrainReport]> {
-        let dim = train
-            .first()
-            .map(Trajectory::dim)
-            .ok_or(NeuralError::NoTrainingData {
-                what: "no training trajectories",
-            })?;
-        if let Some(t) = train.iter().find(|t| t.dim() != dim) {
-            return Err(NeuralError::DimensionMismatch {
-                what: "training trajectory axes",
-                expected: dim,
-                got: t.dim(),
-            });
-        }
+        let dim = common_dim(train)?;
         let (m, h) = (self.layout.window, self.layout.horizon);
         let longest = train.iter().map(Trajectory::len).max().unwrap_or(0);
         if longest < m + h {

@@ -7,6 +7,7 @@ use crate::weights::{effective_sample_size_log, normalize_log_weights};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
 use rand::Rng;
+use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 
 /// Weighted particles `{x_i, w_i}`: the empirical approximation
@@ -25,42 +26,46 @@ impl<T: RealField + Copy, D: Dim> ParticleCloud<T, D>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    /// Particles with log-weights (normalised here). Errors: [`ParticleError::Empty`],
-    /// [`ParticleError::LengthMismatch`], [`ParticleError::DimensionMismatch`] (particles of
-    /// different sizes or of size 0), [`ParticleError::NonFinite`] (a particle),
+    /// Particles with log-weights (normalised here). Errors: [`trajpred_core::Error::Empty`],
+    /// [`trajpred_core::Error::LengthMismatch`], [`trajpred_core::Error::DimensionMismatch`] (particles of
+    /// different sizes or of size 0), [`trajpred_core::Error::NonFinite`] (a particle),
     /// [`ParticleError::InvalidWeight`], [`ParticleError::AllWeightsZero`].
     pub fn new(particles: Vec<OVector<T, D>>, mut log_weights: Vec<f64>) -> Result<Self> {
         let Some(first) = particles.first() else {
-            return Err(ParticleError::Empty { what: "particles" });
+            return Err(CoreError::Empty { what: "particles" }.into());
         };
         if log_weights.len() != particles.len() {
-            return Err(ParticleError::LengthMismatch {
+            return Err(CoreError::LengthMismatch {
                 what: "log-weights vs particles",
                 expected: particles.len(),
                 got: log_weights.len(),
-            });
+            }
+            .into());
         }
         let n = first.nrows();
         if n == 0 {
-            return Err(ParticleError::DimensionMismatch {
+            return Err(CoreError::DimensionMismatch {
                 what: "particle (state dimension must be at least 1)",
                 expected: 1,
                 got: 0,
-            });
+            }
+            .into());
         }
         for (i, p) in particles.iter().enumerate() {
             if p.nrows() != n {
-                return Err(ParticleError::DimensionMismatch {
+                return Err(CoreError::DimensionMismatch {
                     what: "particle",
                     expected: n,
                     got: p.nrows(),
-                });
+                }
+                .into());
             }
             if first_non_finite(p).is_some() {
-                return Err(ParticleError::NonFinite {
+                return Err(CoreError::NonFinite {
                     what: "particle",
                     index: i,
-                });
+                }
+                .into());
             }
         }
         normalize_log_weights(&mut log_weights)?;
@@ -77,29 +82,31 @@ where
     }
 
     /// `n` equally weighted particles drawn from `N(mean, P)` (`P` may be singular).
-    /// Errors: [`ParticleError::Empty`] for `n = 0`, [`ParticleError::NonFinite`],
-    /// [`ParticleError::NotPositiveDefinite`].
+    /// Errors: [`trajpred_core::Error::Empty`] for `n = 0`, [`trajpred_core::Error::NonFinite`],
+    /// [`trajpred_core::Error::NotPositiveDefinite`].
     pub fn sample<R: Rng + ?Sized>(
         initial: &Gaussian<T, D>,
         n: usize,
         rng: &mut R,
     ) -> Result<Self> {
         if n == 0 {
-            return Err(ParticleError::Empty { what: "particles" });
+            return Err(CoreError::Empty { what: "particles" }.into());
         }
         if let Some(index) = first_non_finite(&initial.mean) {
-            return Err(ParticleError::NonFinite {
+            return Err(CoreError::NonFinite {
                 what: "initial mean",
                 index,
-            });
+            }
+            .into());
         }
         let dim = initial.mean.nrows();
         if initial.covariance.nrows() != dim {
-            return Err(ParticleError::DimensionMismatch {
+            return Err(CoreError::DimensionMismatch {
                 what: "initial covariance vs mean",
                 expected: dim,
                 got: initial.covariance.nrows(),
-            });
+            }
+            .into());
         }
         let l = psd_factor(&initial.covariance, "P")?;
         let mut noise: Vec<T> = Vec::new();
@@ -182,20 +189,22 @@ where
     /// The weighted `q`-quantile of state component `component`: the smallest particle
     /// value `v` whose cumulative weight `sum_{x_i <= v} w_i` reaches `q` (the inverse of the
     /// weighted empirical distribution function; particles of zero weight are ignored).
-    /// Errors: [`ParticleError::InvalidParameter`] for `q` outside `[0, 1]` or a component
+    /// Errors: [`trajpred_core::Error::InvalidParameter`] for `q` outside `[0, 1]` or a component
     /// out of range.
     pub fn quantile(&self, component: usize, q: f64) -> Result<T> {
         if !(0.0..=1.0).contains(&q) {
-            return Err(ParticleError::InvalidParameter {
+            return Err(CoreError::InvalidParameter {
                 name: "q",
                 reason: format!("quantile level must be in [0, 1], got {q}"),
-            });
+            }
+            .into());
         }
         if component >= self.dim() {
-            return Err(ParticleError::InvalidParameter {
+            return Err(CoreError::InvalidParameter {
                 name: "component",
                 reason: format!("{component} >= state dimension {}", self.dim()),
-            });
+            }
+            .into());
         }
         let mut pairs: Vec<(T, f64)> = self
             .particles

@@ -2,11 +2,12 @@
 //! with a singular `Q`), Gaussian log-densities through a Cholesky factor, standard normal
 //! draws in any scalar type, conversions to `f64` for log-weights.
 
-use crate::error::{ParticleError, Result};
+use crate::error::Result;
 use nalgebra::allocator::Allocator;
 use nalgebra::{Cholesky, DefaultAllocator, Dim, OMatrix, OVector, RealField, U1};
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
+use trajpred_core::Error as CoreError;
 
 /// `v` as `f64` (NaN if it cannot be represented, which the callers reject as non-finite).
 pub(crate) fn to_f64<T: RealField + Copy>(v: T) -> f64 {
@@ -17,7 +18,7 @@ pub(crate) fn to_f64<T: RealField + Copy>(v: T) -> f64 {
 /// the Cholesky algorithm where a pivot below `n eps max|m|` (a zero eigen-direction, as in
 /// the discrete white-noise `Q`) gives a zero column instead of a failure. A pivot below
 /// minus that tolerance, an asymmetric or a non-finite matrix is
-/// [`ParticleError::NotPositiveDefinite`].
+/// [`trajpred_core::Error::NotPositiveDefinite`].
 pub(crate) fn psd_factor<T, D>(m: &OMatrix<T, D, D>, what: &'static str) -> Result<OMatrix<T, D, D>>
 where
     T: RealField + Copy,
@@ -26,21 +27,22 @@ where
 {
     let n = m.nrows();
     if m.ncols() != n {
-        return Err(ParticleError::DimensionMismatch {
+        return Err(CoreError::DimensionMismatch {
             what,
             expected: n,
             got: m.ncols(),
-        });
+        }
+        .into());
     }
     if m.iter().any(|v| !v.is_finite()) {
-        return Err(ParticleError::NotPositiveDefinite { what });
+        return Err(CoreError::NotPositiveDefinite { what }.into());
     }
     let scale = m.amax();
     let sym_tol = T::default_epsilon().sqrt() * scale.max(T::one());
     for j in 0..n {
         for i in 0..j {
             if (m[(i, j)] - m[(j, i)]).abs() > sym_tol {
-                return Err(ParticleError::NotPositiveDefinite { what });
+                return Err(CoreError::NotPositiveDefinite { what }.into());
             }
         }
     }
@@ -53,7 +55,7 @@ where
             d -= l[(j, k)] * l[(j, k)];
         }
         if d < -tol {
-            return Err(ParticleError::NotPositiveDefinite { what });
+            return Err(CoreError::NotPositiveDefinite { what }.into());
         }
         if d <= tol {
             continue; // zero column
@@ -88,10 +90,9 @@ where
     /// `S` must be symmetric positive definite.
     pub(crate) fn new(s: &OMatrix<T, D, D>, what: &'static str) -> Result<Self> {
         if s.iter().any(|v| !v.is_finite()) {
-            return Err(ParticleError::NotPositiveDefinite { what });
+            return Err(CoreError::NotPositiveDefinite { what }.into());
         }
-        let chol =
-            Cholesky::new(s.clone_owned()).ok_or(ParticleError::NotPositiveDefinite { what })?;
+        let chol = Cholesky::new(s.clone_owned()).ok_or(CoreError::NotPositiveDefinite { what })?;
         // a singular matrix can pass the factorisation with a rounding-size pivot: require
         // every pivot L_ii^2 above n eps max|S|
         let floor = to_f64(s.amax()) * f64::EPSILON * 64.0 * s.nrows() as f64;
@@ -100,12 +101,12 @@ where
             let d = to_f64(l[(i, i)]);
             d.is_nan() || d * d <= floor
         }) {
-            return Err(ParticleError::NotPositiveDefinite { what });
+            return Err(CoreError::NotPositiveDefinite { what }.into());
         }
         let log_norm =
             -0.5 * (s.nrows() as f64 * (2.0 * std::f64::consts::PI).ln()) - log_det_half(&chol);
         if !log_norm.is_finite() {
-            return Err(ParticleError::NotPositiveDefinite { what });
+            return Err(CoreError::NotPositiveDefinite { what }.into());
         }
         Ok(Density { chol, log_norm })
     }

@@ -3,18 +3,18 @@
 //! Kalman crate's own (`trajpred_kalman::Ukf`, `trajpred_kalman::Ekf`).
 
 use crate::cloud::ParticleCloud;
-use crate::error::{ParticleError, Result};
+use crate::error::Result;
 use crate::gauss::{Density, first_non_finite, log_det_half, psd_factor, shifted, to_f64};
 use crate::pf::{
-    MIN_PARTICLES_PER_TASK, ParticleFiltering, PfConfig, StepSummary, log_likelihood,
+    MIN_PARTICLES_PER_TASK, ParticleFiltering, PfConfig, StepSummary, finish_step, log_likelihood,
     predict_clouds, propagate_one, step_noise, weigh_and_select,
 };
-use crate::weights::normalize_log_weights;
 use nalgebra::allocator::Allocator;
 use nalgebra::{Cholesky, DefaultAllocator, Dim, OMatrix, OVector, RealField};
 use rand::Rng;
 use rayon::prelude::*;
 use std::marker::PhantomData;
+use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 use trajpred_kalman::FilterAllocator;
 use trajpred_kalman::{
@@ -146,7 +146,7 @@ where
 /// resampled, by the residual scheme every step by default ([`PfConfig`]).
 ///
 /// The transition density needs `Q` positive definite (a singular `Q` is
-/// [`ParticleError::NotPositiveDefinite`] at construction). A particle whose UKF or EKF step
+/// [`trajpred_core::Error::NotPositiveDefinite`] at construction). A particle whose UKF or EKF step
 /// fails (e.g. `S` not positive definite) falls back to the transition prior as its proposal
 /// for that step (counted in [`StepSummary::fallbacks`]). A missing observation propagates
 /// each particle through the transition (weights unchanged) and its covariance by the UKF
@@ -230,8 +230,8 @@ where
     /// An MKPF over `cloud`, every particle starting with the covariance `initial_covariance`
     /// (the paper's `P_0^i = P_0`), with the sigma-point parameters `points` (the paper:
     /// `alpha = 1e-3, beta = 2, kappa = 0`, [`MerweSigmaPoints::default`]). Errors:
-    /// [`ParticleError::DimensionMismatch`], [`ParticleError::NotPositiveDefinite`] (`"Q"`
-    /// must be positive definite, `"R"`, `"P"`), [`ParticleError::Kalman`] (degenerate
+    /// [`trajpred_core::Error::DimensionMismatch`], [`trajpred_core::Error::NotPositiveDefinite`] (`"Q"`
+    /// must be positive definite, `"R"`, `"P"`), [`ParticleError::Kalman`](crate::ParticleError::Kalman) (degenerate
     /// sigma points).
     pub fn new(
         transition: Tr,
@@ -242,18 +242,20 @@ where
     ) -> Result<Self> {
         let n = transition.state_dim();
         if cloud.dim() != n {
-            return Err(ParticleError::DimensionMismatch {
+            return Err(CoreError::DimensionMismatch {
                 what: "particles vs transition",
                 expected: n,
                 got: cloud.dim(),
-            });
+            }
+            .into());
         }
         if initial_covariance.nrows() != n || initial_covariance.ncols() != n {
-            return Err(ParticleError::DimensionMismatch {
+            return Err(CoreError::DimensionMismatch {
                 what: "initial covariance vs transition",
                 expected: n,
                 got: initial_covariance.nrows(),
-            });
+            }
+            .into());
         }
         psd_factor(&initial_covariance, "P")?;
         points.weights(n)?;
@@ -548,7 +550,7 @@ where
         rng: &mut R,
     ) -> Result<StepSummary<T, D>> {
         let noise = step_noise(&self.cloud, self.observation.observation_dim(), z, rng)?;
-        let (n, count) = (self.cloud.dim(), self.cloud.len());
+        let n = self.cloud.dim();
         let this = &*self;
         let ukf = this.ukf_stage()?;
         let moved: Vec<Moved<T, D>> = this
@@ -569,30 +571,19 @@ where
             .collect();
         let (select, ess, lse) = weigh_and_select(&mut log_w, &self.config, rng)?;
         let fallbacks = moved.iter().filter(|m| m.fallback).count();
-        let (mut particles, mut covs): (Vec<_>, Vec<_>) =
-            moved.into_iter().map(|m| (m.x, m.p)).unzip();
-        let weighted = ParticleCloud::new(particles.clone(), log_w.clone())?;
-        let estimate = weighted.estimate();
-        let resampled = select.is_some();
-        if let Some(idx) = select {
-            particles = idx.iter().map(|&i| particles[i].clone()).collect();
+        let (particles, mut covs): (Vec<_>, Vec<_>) = moved.into_iter().map(|m| (m.x, m.p)).unzip();
+        if let Some(idx) = &select {
             covs = idx.iter().map(|&i| covs[i].clone()).collect();
-            log_w = vec![0.0; count];
-        }
-        let (ps, ws) = self.cloud.parts_mut();
-        *ps = particles;
-        *ws = log_w;
-        if resampled {
-            normalize_log_weights(ws)?;
         }
         self.covariances = covs;
-        Ok(StepSummary {
-            estimate,
-            ess,
-            resampled,
-            log_likelihood: if z.is_some() { lse } else { 0.0 },
+        finish_step(
+            &mut self.cloud,
+            particles,
+            log_w,
+            (select.as_deref(), ess, lse),
+            z.is_some(),
             fallbacks,
-        })
+        )
     }
 
     fn cloud(&self) -> &ParticleCloud<T, D> {

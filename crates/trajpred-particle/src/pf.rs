@@ -3,7 +3,7 @@
 //! per-step summary ([`StepSummary`]).
 
 use crate::cloud::ParticleCloud;
-use crate::error::{ParticleError, Result};
+use crate::error::Result;
 use crate::gauss::{Density, first_non_finite, psd_factor, push_normals, shifted};
 use crate::resample::{Resampler, Resampling};
 use crate::weights::{ResamplePolicy, effective_sample_size_log, normalize_log_weights};
@@ -12,6 +12,7 @@ use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
 use rand::Rng;
 use rayon::prelude::*;
 use std::marker::PhantomData;
+use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 use trajpred_kalman::driver::scan;
 use trajpred_kalman::{Observation, Transition};
@@ -64,7 +65,7 @@ where
     /// (`None`: predict only, weights unchanged).
     ///
     /// On error the filter is left as it was before the call (in particular for
-    /// [`ParticleError::AllWeightsZero`], an observation impossible under every particle:
+    /// [`ParticleError::AllWeightsZero`](crate::ParticleError::AllWeightsZero), an observation impossible under every particle:
     /// the caller may skip it and continue).
     fn step<R: Rng + ?Sized>(
         &mut self,
@@ -138,17 +139,19 @@ where
     DefaultAllocator: Allocator<M>,
 {
     if z.nrows() != m {
-        return Err(ParticleError::DimensionMismatch {
+        return Err(CoreError::DimensionMismatch {
             what: "observation",
             expected: m,
             got: z.nrows(),
-        });
+        }
+        .into());
     }
     if let Some(index) = first_non_finite(z) {
-        return Err(ParticleError::NonFinite {
+        return Err(CoreError::NonFinite {
             what: "observation",
             index,
-        });
+        }
+        .into());
     }
     Ok(())
 }
@@ -169,11 +172,12 @@ where
 {
     let zp = observation.observe(x)?;
     if zp.nrows() != z.nrows() {
-        return Err(ParticleError::DimensionMismatch {
+        return Err(CoreError::DimensionMismatch {
             what: "h(x)",
             expected: z.nrows(),
             got: zp.nrows(),
-        });
+        }
+        .into());
     }
     Ok(density.log_density(&observation.observation_residual(z, &zp)))
 }
@@ -193,18 +197,20 @@ where
 {
     let fx = transition.transition(x)?;
     if fx.nrows() != x.nrows() {
-        return Err(ParticleError::DimensionMismatch {
+        return Err(CoreError::DimensionMismatch {
             what: "f(x)",
             expected: x.nrows(),
             got: fx.nrows(),
-        });
+        }
+        .into());
     }
     let out = shifted(&fx, q_factor, e);
     if let Some(index) = first_non_finite(&out) {
-        return Err(ParticleError::NonFinite {
+        return Err(CoreError::NonFinite {
             what: "propagated particle",
             index,
-        });
+        }
+        .into());
     }
     Ok(out)
 }
@@ -261,6 +267,47 @@ pub(crate) fn weigh_and_select<R: Rng + ?Sized>(
     Ok((Some(idx), ess, lse))
 }
 
+/// The end of a step, the same for both filters: the estimate of the moved particles under
+/// their new normalised `log_w`; then the particles (the ancestors in `select` when it is
+/// `Some`, with equal weights) become the cloud. Returns the step's summary, with the ESS
+/// and log-likelihood increment `lse` of [`weigh_and_select`] (the increment reported only
+/// when the step had an observation) and the count of `fallbacks`.
+pub(crate) fn finish_step<T, D>(
+    cloud: &mut ParticleCloud<T, D>,
+    mut particles: Vec<OVector<T, D>>,
+    mut log_w: Vec<f64>,
+    (select, ess, lse): (Option<&[usize]>, f64, f64),
+    observed: bool,
+    fallbacks: usize,
+) -> Result<StepSummary<T, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    let count = cloud.len();
+    let weighted = ParticleCloud::new(particles.clone(), log_w.clone())?;
+    let estimate = weighted.estimate();
+    let resampled = select.is_some();
+    if let Some(idx) = select {
+        particles = idx.iter().map(|&i| particles[i].clone()).collect();
+        log_w = vec![0.0; count];
+    }
+    let (ps, ws) = cloud.parts_mut();
+    *ps = particles;
+    *ws = log_w;
+    if resampled {
+        normalize_log_weights(ws)?;
+    }
+    Ok(StepSummary {
+        estimate,
+        ess,
+        resampled,
+        log_likelihood: if observed { lse } else { 0.0 },
+        fallbacks,
+    })
+}
+
 /// The bootstrap (sampling importance resampling) particle filter of Gordon et al.: propose
 /// from the transition, `x_k^i = f(x_(k-1)^i) + w`, `w ~ N(0, Q)` (a singular `Q`, such as
 /// the discrete white-noise model, is fine), weight by the likelihood
@@ -315,16 +362,17 @@ where
 {
     /// A filter over `cloud` with the transition (`f`, `Q` positive semi-definite) and the
     /// observation (`h`, `R` positive definite). Errors:
-    /// [`ParticleError::DimensionMismatch`], [`ParticleError::NotPositiveDefinite`] (`"Q"`,
+    /// [`trajpred_core::Error::DimensionMismatch`], [`trajpred_core::Error::NotPositiveDefinite`] (`"Q"`,
     /// `"R"`).
     pub fn new(transition: Tr, observation: Ob, cloud: ParticleCloud<T, D>) -> Result<Self> {
         let n = transition.state_dim();
         if cloud.dim() != n {
-            return Err(ParticleError::DimensionMismatch {
+            return Err(CoreError::DimensionMismatch {
                 what: "particles vs transition",
                 expected: n,
                 got: cloud.dim(),
-            });
+            }
+            .into());
         }
         let q_factor = psd_factor(transition.process_noise(), "Q")?;
         let likelihood = Density::new(observation.observation_noise(), "R")?;
@@ -401,7 +449,7 @@ where
         rng: &mut R,
     ) -> Result<StepSummary<T, D>> {
         let noise = step_noise(&self.cloud, self.observation.observation_dim(), z, rng)?;
-        let (n, count) = (self.cloud.dim(), self.cloud.len());
+        let n = self.cloud.dim();
         let (tr, ob, lik, qf) = (
             &self.transition,
             &self.observation,
@@ -431,27 +479,15 @@ where
             .map(|(l, (_, ll))| l + ll)
             .collect();
         let (select, ess, lse) = weigh_and_select(&mut log_w, &self.config, rng)?;
-        let mut particles: Vec<OVector<T, D>> = moved.into_iter().map(|(x, _)| x).collect();
-        let weighted = ParticleCloud::new(particles.clone(), log_w.clone())?;
-        let estimate = weighted.estimate();
-        let resampled = select.is_some();
-        if let Some(idx) = select {
-            particles = idx.iter().map(|&i| particles[i].clone()).collect();
-            log_w = vec![0.0; count];
-        }
-        let (ps, ws) = self.cloud.parts_mut();
-        *ps = particles;
-        *ws = log_w;
-        if resampled {
-            normalize_log_weights(ws)?;
-        }
-        Ok(StepSummary {
-            estimate,
-            ess,
-            resampled,
-            log_likelihood: if z.is_some() { lse } else { 0.0 },
-            fallbacks: 0,
-        })
+        let particles: Vec<OVector<T, D>> = moved.into_iter().map(|(x, _)| x).collect();
+        finish_step(
+            &mut self.cloud,
+            particles,
+            log_w,
+            (select.as_deref(), ess, lse),
+            z.is_some(),
+            0,
+        )
     }
 
     fn cloud(&self) -> &ParticleCloud<T, D> {

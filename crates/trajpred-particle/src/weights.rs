@@ -2,6 +2,7 @@
 //! that decides when to resample ([`ResamplePolicy`]).
 
 use crate::error::{ParticleError, Result};
+use trajpred_core::Error as CoreError;
 
 /// Checks a log-weight: NaN and `+inf` are invalid, `-inf` (weight zero) is allowed.
 fn check_log_weight(index: usize, value: f64) -> Result<()> {
@@ -15,7 +16,7 @@ fn check_log_weight(index: usize, value: f64) -> Result<()> {
 /// `ln sum_i exp(l_i)`, computed stably as `m + ln sum_i exp(l_i - m)` with `m = max l_i`.
 ///
 /// Returns `-inf` when every `l_i` is `-inf` (all weights zero). Errors:
-/// [`ParticleError::Empty`], [`ParticleError::InvalidWeight`] for a NaN or `+inf`.
+/// [`trajpred_core::Error::Empty`], [`ParticleError::InvalidWeight`] for a NaN or `+inf`.
 ///
 /// ```
 /// use trajpred_particle::log_sum_exp;
@@ -25,9 +26,10 @@ fn check_log_weight(index: usize, value: f64) -> Result<()> {
 /// ```
 pub fn log_sum_exp(log_weights: &[f64]) -> Result<f64> {
     if log_weights.is_empty() {
-        return Err(ParticleError::Empty {
+        return Err(CoreError::Empty {
             what: "log-weights",
-        });
+        }
+        .into());
     }
     let mut max = f64::NEG_INFINITY;
     for (i, &l) in log_weights.iter().enumerate() {
@@ -47,7 +49,7 @@ pub fn log_sum_exp(log_weights: &[f64]) -> Result<f64> {
 /// their previous total, `ln sum_i exp(l_i)` (for a particle filter: the log-likelihood
 /// increment `ln p(z_k | z_1:k-1)` when the weights were normalised before the update).
 ///
-/// Errors: [`ParticleError::Empty`], [`ParticleError::InvalidWeight`],
+/// Errors: [`trajpred_core::Error::Empty`], [`ParticleError::InvalidWeight`],
 /// [`ParticleError::AllWeightsZero`] when every log-weight is `-inf` (the weights are then
 /// left untouched).
 pub fn normalize_log_weights(log_weights: &mut [f64]) -> Result<f64> {
@@ -65,14 +67,15 @@ pub fn normalize_log_weights(log_weights: &mut [f64]) -> Result<f64> {
 
 /// Writes the normalised linear weights `exp(l_i - lse(l))` into `out` (no allocation).
 ///
-/// Errors: as [`normalize_log_weights`], and [`ParticleError::LengthMismatch`].
+/// Errors: as [`normalize_log_weights`], and [`trajpred_core::Error::LengthMismatch`].
 pub fn weights_from_log_into(log_weights: &[f64], out: &mut [f64]) -> Result<()> {
     if out.len() != log_weights.len() {
-        return Err(ParticleError::LengthMismatch {
+        return Err(CoreError::LengthMismatch {
             what: "weights buffer vs log-weights",
             expected: log_weights.len(),
             got: out.len(),
-        });
+        }
+        .into());
     }
     let total = log_sum_exp(log_weights)?;
     if total == f64::NEG_INFINITY {
@@ -90,11 +93,11 @@ pub fn weights_from_log_into(log_weights: &[f64], out: &mut [f64]) -> Result<()>
 /// internally; `1 / sum w_i^2` for normalised weights): `N` for equal weights, 1 when one
 /// particle holds all the weight.
 ///
-/// Errors: [`ParticleError::Empty`], [`ParticleError::InvalidWeight`] (negative or
+/// Errors: [`trajpred_core::Error::Empty`], [`ParticleError::InvalidWeight`] (negative or
 /// non-finite), [`ParticleError::AllWeightsZero`].
 pub fn effective_sample_size(weights: &[f64]) -> Result<f64> {
     if weights.is_empty() {
-        return Err(ParticleError::Empty { what: "weights" });
+        return Err(CoreError::Empty { what: "weights" }.into());
     }
     let mut max = 0.0f64;
     for (index, &value) in weights.iter().enumerate() {
@@ -155,10 +158,11 @@ impl ResamplePolicy {
     pub fn validate(&self) -> Result<()> {
         match *self {
             ResamplePolicy::EssBelow(f) if !(f.is_finite() && (0.0..=1.0).contains(&f)) => {
-                Err(ParticleError::InvalidParameter {
+                Err(CoreError::InvalidParameter {
                     name: "ess fraction",
                     reason: format!("must be in [0, 1], got {f}"),
-                })
+                }
+                .into())
             }
             _ => Ok(()),
         }

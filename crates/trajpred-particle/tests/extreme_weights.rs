@@ -10,6 +10,7 @@
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use trajpred_core::Error as CoreError;
 use trajpred_particle::{
     ParticleError, Resampler, Resampling, multinomial_indices, residual_indices,
     stratified_indices, systematic_indices,
@@ -64,9 +65,9 @@ fn assert_valid(weights: &[f64], n: usize, name: &str, res: &Result<Vec<usize>, 
         }
         Err(
             ParticleError::AllWeightsZero { .. }
-            | ParticleError::NonFinite { .. }
+            | ParticleError::Core(CoreError::NonFinite { .. })
             | ParticleError::InvalidWeight { .. }
-            | ParticleError::Empty { .. },
+            | ParticleError::Core(CoreError::Empty { .. }),
         ) => {}
         Err(e) => panic!("{name}: unexpected error {e:?}"),
     }
@@ -162,7 +163,7 @@ fn huge_weights() {
     let w = [f64::MAX, f64::MAX, 1.0];
     for (name, res) in every_scheme(&w, 10, &mut rng) {
         assert!(
-            matches!(res, Err(ParticleError::NonFinite { .. })),
+            matches!(res, Err(ParticleError::Core(CoreError::NonFinite { .. }))),
             "{name}: {res:?}"
         );
     }

@@ -1,7 +1,9 @@
 //! The filters compile and run in `f32` (weights stay `f64`), and agree with the `f64` runs
 //! of the same seed.
 
-use nalgebra::{Matrix1, Matrix1x2, Matrix2, Matrix5, U1, U2, U5, Vector1, Vector2, Vector5};
+use nalgebra::{
+    Matrix1, Matrix1x2, Matrix2, Matrix5, RealField, U1, U2, U5, Vector1, Vector2, Vector5,
+};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use trajpred_core::Gaussian;
@@ -13,117 +15,50 @@ use trajpred_particle::{Mkpf, ParticleFilter, ParticleFiltering};
 
 #[test]
 fn bootstrap_and_mkpf_run_in_f32() {
-    let mut rng = ChaCha8Rng::seed_from_u64(3);
-    let tr = LinearTransition::new(
-        Matrix2::new(1.0f32, 1.0, 0.0, 1.0),
-        Matrix2::identity() * 0.1,
-    )
-    .expect("tr");
-    let ob = LinearObservation::new(Matrix1x2::new(1.0f32, 0.0), Matrix1::new(0.5)).expect("ob");
-    let x0 = Gaussian {
-        mean: Vector2::new(0.0f32, 1.0),
-        covariance: Matrix2::identity(),
-    };
-    let mut pf =
-        ParticleFilter::<f32, U2, U1, _, _>::from_gaussian(tr, ob, &x0, 200, &mut rng).expect("pf");
-    let s = pf
-        .step(Some(&Vector1::new(1.0f32)), &mut rng)
-        .expect("step");
+    let (pf, mk) = run::<f32>(3);
     // the posterior mean of x lies between the prior mean 1 and the observation 1
-    assert!(
-        (s.estimate.mean[0] - 1.0).abs() < 0.3,
-        "{}",
-        s.estimate.mean[0]
-    );
-
-    let q = Matrix5::from_diagonal(&Vector5::new(4.0f32, 1.0, 4.0, 1.0, 1e-4));
-    let ct = CoordinatedTurn::with_process_noise(1.0, q).expect("ct");
-    let rb = RangeBearing::new(Vector2::new(0.0f32, 0.0), 0, 2, 1.0, 1e-6).expect("rb");
-    let x = Vector5::new(1000.0f32, 10.0, 1000.0, 0.0, 0.05);
-    let x0 = Gaussian {
-        mean: x,
-        covariance: Matrix5::from_diagonal(&Vector5::new(25.0f32, 4.0, 25.0, 4.0, 1e-3)),
-    };
-    let mut m = Mkpf::<f32, U5, U2, _, _>::from_gaussian(
-        ct,
-        rb.clone(),
-        &x0,
-        10,
-        MerweSigmaPoints::default(),
-        &mut rng,
-    )
-    .expect("mkpf");
-    let z = rb.observe(&x).expect("z");
-    let s = m.step(Some(&z), &mut rng).expect("step");
-    assert!(s.estimate.mean.iter().all(|v| v.is_finite()));
+    assert!((pf[0] - 1.0).abs() < 0.3, "{}", pf[0]);
+    assert!(mk.iter().all(|v| v.is_finite()));
 }
 
-/// One bootstrap step and one MKPF step, in f64, with the same seed and inputs as the f32
-/// test above; returns the two posterior means.
-fn run_f64(seed: u64) -> (Vec<f64>, Vec<f64>) {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let tr = LinearTransition::new(Matrix2::new(1.0, 1.0, 0.0, 1.0), Matrix2::identity() * 0.1)
-        .expect("tr");
-    let ob = LinearObservation::new(Matrix1x2::new(1.0, 0.0), Matrix1::new(0.5)).expect("ob");
-    let x0 = Gaussian {
-        mean: Vector2::new(0.0, 1.0),
-        covariance: Matrix2::identity(),
-    };
-    let mut pf =
-        ParticleFilter::<f64, U2, U1, _, _>::from_gaussian(tr, ob, &x0, 200, &mut rng).expect("pf");
-    let a = pf.step(Some(&Vector1::new(1.0)), &mut rng).expect("step");
-    let q = Matrix5::from_diagonal(&Vector5::new(4.0, 1.0, 4.0, 1.0, 1e-4));
-    let ct = CoordinatedTurn::with_process_noise(1.0, q).expect("ct");
-    let rb = RangeBearing::new(Vector2::new(0.0, 0.0), 0, 2, 1.0, 1e-6).expect("rb");
-    let x = Vector5::new(1000.0, 10.0, 1000.0, 0.0, 0.05);
-    let x0 = Gaussian {
-        mean: x,
-        covariance: Matrix5::from_diagonal(&Vector5::new(25.0, 4.0, 25.0, 4.0, 1e-3)),
-    };
-    let mut m = Mkpf::<f64, U5, U2, _, _>::from_gaussian(
-        ct,
-        rb.clone(),
-        &x0,
-        10,
-        MerweSigmaPoints::default(),
-        &mut rng,
-    )
-    .expect("mkpf");
-    let z = rb.observe(&x).expect("z");
-    let b = m.step(Some(&z), &mut rng).expect("step");
-    (
-        a.estimate.mean.iter().copied().collect(),
-        b.estimate.mean.iter().copied().collect(),
-    )
-}
-
-/// The same runs in f32 (the code of the test above).
-fn run_f32(seed: u64) -> (Vec<f64>, Vec<f64>) {
+/// One bootstrap step and one MKPF step in the scalar `T` (`f32` or `f64`), from the seed
+/// `seed`; returns the two posterior means, widened to `f64`. Every constant is written once
+/// as an `f64` and converted to `T` (exact for the `f32` literals used: each rounds to the
+/// same `f32` either way).
+fn run<T: RealField + Copy + Into<f64>>(seed: u64) -> (Vec<f64>, Vec<f64>) {
+    let c = |v: f64| -> T { nalgebra::convert(v) };
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let tr = LinearTransition::new(
-        Matrix2::new(1.0f32, 1.0, 0.0, 1.0),
-        Matrix2::identity() * 0.1,
+        Matrix2::new(c(1.0), c(1.0), c(0.0), c(1.0)),
+        Matrix2::identity() * c(0.1),
     )
     .expect("tr");
-    let ob = LinearObservation::new(Matrix1x2::new(1.0f32, 0.0), Matrix1::new(0.5)).expect("ob");
+    let ob =
+        LinearObservation::new(Matrix1x2::new(c(1.0), c(0.0)), Matrix1::new(c(0.5))).expect("ob");
     let x0 = Gaussian {
-        mean: Vector2::new(0.0f32, 1.0),
+        mean: Vector2::new(c(0.0), c(1.0)),
         covariance: Matrix2::identity(),
     };
     let mut pf =
-        ParticleFilter::<f32, U2, U1, _, _>::from_gaussian(tr, ob, &x0, 200, &mut rng).expect("pf");
+        ParticleFilter::<T, U2, U1, _, _>::from_gaussian(tr, ob, &x0, 200, &mut rng).expect("pf");
     let a = pf
-        .step(Some(&Vector1::new(1.0f32)), &mut rng)
+        .step(Some(&Vector1::new(c(1.0))), &mut rng)
         .expect("step");
-    let q = Matrix5::from_diagonal(&Vector5::new(4.0f32, 1.0, 4.0, 1.0, 1e-4));
+    let q = Matrix5::from_diagonal(&Vector5::new(c(4.0), c(1.0), c(4.0), c(1.0), c(1e-4)));
     let ct = CoordinatedTurn::with_process_noise(1.0, q).expect("ct");
-    let rb = RangeBearing::new(Vector2::new(0.0f32, 0.0), 0, 2, 1.0, 1e-6).expect("rb");
-    let x = Vector5::new(1000.0f32, 10.0, 1000.0, 0.0, 0.05);
+    let rb = RangeBearing::new(Vector2::new(c(0.0), c(0.0)), 0, 2, 1.0, 1e-6).expect("rb");
+    let x = Vector5::new(c(1000.0), c(10.0), c(1000.0), c(0.0), c(0.05));
     let x0 = Gaussian {
         mean: x,
-        covariance: Matrix5::from_diagonal(&Vector5::new(25.0f32, 4.0, 25.0, 4.0, 1e-3)),
+        covariance: Matrix5::from_diagonal(&Vector5::new(
+            c(25.0),
+            c(4.0),
+            c(25.0),
+            c(4.0),
+            c(1e-3),
+        )),
     };
-    let mut m = Mkpf::<f32, U5, U2, _, _>::from_gaussian(
+    let mut m = Mkpf::<T, U5, U2, _, _>::from_gaussian(
         ct,
         rb.clone(),
         &x0,
@@ -135,8 +70,8 @@ fn run_f32(seed: u64) -> (Vec<f64>, Vec<f64>) {
     let z = rb.observe(&x).expect("z");
     let b = m.step(Some(&z), &mut rng).expect("step");
     (
-        a.estimate.mean.iter().map(|&v| f64::from(v)).collect(),
-        b.estimate.mean.iter().map(|&v| f64::from(v)).collect(),
+        a.estimate.mean.iter().map(|&v| v.into()).collect(),
+        b.estimate.mean.iter().map(|&v| v.into()).collect(),
     )
 }
 
@@ -157,8 +92,8 @@ fn run_f32(seed: u64) -> (Vec<f64>, Vec<f64>) {
 fn f32_runs_agree_with_f64_runs_of_the_same_seed() {
     let prior_sd = [5.0, 2.0, 5.0, 2.0, 1e-3f64.sqrt()];
     for seed in [3, 4, 5] {
-        let (pf64, mk64) = run_f64(seed);
-        let (pf32, mk32) = run_f32(seed);
+        let (pf64, mk64) = run::<f64>(seed);
+        let (pf32, mk32) = run::<f32>(seed);
         for (k, (a, b)) in pf32.iter().zip(&pf64).enumerate() {
             assert!(
                 (a - b).abs() <= 1e-5,

@@ -8,7 +8,9 @@ use trajpred_repro::report::{
     check_run, format_number, replace_run, write_atomic, write_atomic_with, write_index,
     write_paper,
 };
-use trajpred_repro::{Difference, Figure, PaperResult, ReproError, RunInfo, Table, Value};
+use trajpred_repro::{
+    Context, Difference, Figure, Paper, PaperResult, ReproError, RunInfo, Table, Value, run_info,
+};
 
 fn table() -> Table {
     let mut t = Table::new("table1", "Table 1: a test")
@@ -86,28 +88,17 @@ fn figure(id: &str) -> Figure {
     }
 }
 
+/// The [`RunInfo`] that `run_info` gives `result` as a quick `gskf` run (seed 1, 1.5 s, revision
+/// `abc`), under the title `A paper`.
 fn info_of(result: &PaperResult) -> RunInfo {
-    RunInfo {
-        paper: "gskf".into(),
-        title: "A paper".into(),
-        seed: 1,
-        revision: "abc".into(),
+    let ctx = Context {
         quick: true,
-        wall_seconds: 1.5,
-        data: vec![],
-        missing: result.missing.clone(),
-        claims: result.claims.clone(),
-        notes: result.notes.clone(),
-        tables: result
-            .tables
-            .iter()
-            .map(|t| (t.id.clone(), t.title.clone()))
-            .collect(),
-        figures: result
-            .figures
-            .iter()
-            .map(|f| (f.id.clone(), f.caption.clone()))
-            .collect(),
+        seed: 1,
+        ..Context::default()
+    };
+    RunInfo {
+        title: "A paper".into(),
+        ..run_info(Paper::Gskf, &ctx, result, 1.5, "abc")
     }
 }
 

@@ -37,18 +37,13 @@ pub struct GscParams {
 }
 
 impl GscParams {
-    /// The LARS settings of every horizon's fit (default: [`Lars::params`], the full LAR
-    /// path with intercept and unit-norm columns, whose end is least squares).
-    pub fn lars(mut self, lars: LarsParams) -> Self {
-        self.lars = lars;
-        self
-    }
-
-    /// Fit the horizons in parallel with rayon when the problem is large enough to pay
-    /// (default `true`); `false` always fits them one after another.
-    pub fn parallel(mut self, yes: bool) -> Self {
-        self.parallel = yes;
-        self
+    setters! {
+        /// The LARS settings of every horizon's fit (default: [`Lars::params`], the full LAR
+        /// path with intercept and unit-norm columns, whose end is least squares).
+        lars(lars: LarsParams) => self.lars = lars;
+        /// Fit the horizons in parallel with rayon when the problem is large enough to pay
+        /// (default `true`); `false` always fits them one after another.
+        parallel(yes: bool) => self.parallel = yes;
     }
 
     /// Fits the `T` horizon models on `series` (oldest first).

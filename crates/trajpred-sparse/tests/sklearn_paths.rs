@@ -97,6 +97,25 @@ fn fit_plain(c: &Value, gram: Gram) -> Lars {
     params.fit(&x, &y).expect("fit")
 }
 
+/// The fixture's cases named `names`, each with its name.
+fn cases<'a>(f: &'a Value, names: &'a [&'a str]) -> impl Iterator<Item = (&'a str, &'a Value)> {
+    names.iter().map(move |&name| (name, case(f, name)))
+}
+
+/// scikit-learn's active set of case `c`, in order of entry.
+fn active(c: &Value) -> Vec<usize> {
+    serde_json::from_value(c["active"].clone()).expect("active")
+}
+
+/// Our path has as many knots as scikit-learn's for case `name` (`c`) and the same
+/// standardized path ([`assert_path_matches`]); returns the number of knots.
+fn assert_knots_match(fit: &Lars, c: &Value, name: &str) -> usize {
+    let knots = vector(&c["alphas"]).len();
+    assert_eq!(fit.n_knots(), knots, "{name}: number of knots");
+    assert_path_matches(fit, c, knots, 1.0);
+    knots
+}
+
 fn active_sequence(fit: &Lars) -> Vec<usize> {
     fit.active().to_vec()
 }
@@ -104,20 +123,19 @@ fn active_sequence(fit: &Lars) -> Vec<usize> {
 #[test]
 fn diabetes_paths_match_sklearn_with_and_without_gram() {
     let f = fixture();
-    for name in [
-        "diabetes_lar",
-        "diabetes_lasso",
-        "diabetes_lasso_alpha_min",
-        "diabetes_lar_max_iter",
-    ] {
-        let c = case(&f, name);
+    for (name, c) in cases(
+        &f,
+        &[
+            "diabetes_lar",
+            "diabetes_lasso",
+            "diabetes_lasso_alpha_min",
+            "diabetes_lar_max_iter",
+        ],
+    ) {
         for gram in [Gram::Precompute, Gram::Never] {
             let fit = fit_plain(c, gram);
-            let knots = vector(&c["alphas"]).len();
-            assert_eq!(fit.n_knots(), knots, "{name}: number of knots");
-            assert_path_matches(&fit, c, knots, 1.0);
-            let active: Vec<usize> = serde_json::from_value(c["active"].clone()).expect("active");
-            assert_eq!(active_sequence(&fit), active, "{name}: active set");
+            assert_knots_match(&fit, c, name);
+            assert_eq!(active_sequence(&fit), active(c), "{name}: active set");
         }
     }
 }
@@ -147,16 +165,13 @@ fn diabetes_raw_with_intercept_and_normalisation_matches_sklearn_on_original_sca
     let f = fixture();
     let x_raw = matrix(&f["diabetes"]["x_raw"]);
     let y = vector(&f["diabetes"]["target"]);
-    for name in ["diabetes_lar", "diabetes_lasso"] {
-        let c = case(&f, name);
+    for (name, c) in cases(&f, &["diabetes_lar", "diabetes_lasso"]) {
         let fit = Lars::params()
             .method(method(c))
             .fit(&x_raw, &y)
             .expect("fit");
-        let knots = vector(&c["alphas"]).len();
-        assert_eq!(fit.n_knots(), knots);
         // our standardisation of the raw data is the fixture's: same standardised path
-        assert_path_matches(&fit, c, knots, 1.0);
+        let knots = assert_knots_match(&fit, c, name);
         let orig = matrix(&c["coefs_original"]);
         let intercepts = vector(&c["intercepts"]);
         let cmax = orig.amax();
@@ -201,18 +216,18 @@ fn scaled_diabetes_data_equals_standardised_raw_data() {
 #[test]
 fn correlated_and_sign_flip_lasso_match_sklearn() {
     let f = fixture();
-    for name in [
-        "correlated_lar",
-        "correlated_lasso",
-        "sign_flip_lasso",
-        "collinear_lar",
-        "scale_unit_lar",
-    ] {
-        let c = case(&f, name);
+    for (name, c) in cases(
+        &f,
+        &[
+            "correlated_lar",
+            "correlated_lasso",
+            "sign_flip_lasso",
+            "collinear_lar",
+            "scale_unit_lar",
+        ],
+    ) {
         let fit = fit_plain(c, Gram::Auto);
-        let knots = vector(&c["alphas"]).len();
-        assert_eq!(fit.n_knots(), knots, "{name}: knots");
-        assert_path_matches(&fit, c, knots, 1.0);
+        assert_knots_match(&fit, c, name);
     }
 }
 
@@ -240,14 +255,16 @@ fn collinear_and_duplicate_columns_are_excluded_and_reported() {
 fn lars_path_returns_sklearns_values_in_sklearns_layout() {
     use trajpred_sparse::{LarsPathOptions, lars_path};
     let f = fixture();
-    for name in [
-        "diabetes_lar",
-        "diabetes_lasso",
-        "diabetes_lasso_alpha_min",
-        "diabetes_lar_max_iter",
-        "correlated_lasso",
-    ] {
-        let c = case(&f, name);
+    for (name, c) in cases(
+        &f,
+        &[
+            "diabetes_lar",
+            "diabetes_lasso",
+            "diabetes_lasso_alpha_min",
+            "diabetes_lar_max_iter",
+            "correlated_lasso",
+        ],
+    ) {
         let x = matrix(&c["x"]);
         let y = vector(&c["y"]);
         let mut opts = LarsPathOptions::default();
@@ -268,8 +285,7 @@ fn lars_path_returns_sklearns_values_in_sklearns_layout() {
             (x.ncols(), alphas.len()),
             "{name}: layout"
         );
-        let active: Vec<usize> = serde_json::from_value(c["active"].clone()).expect("active");
-        assert_eq!(path.active, active, "{name}: active");
+        assert_eq!(path.active, active(c), "{name}: active");
         let err = rel_err(&path.alphas, &alphas, alphas[0] * 1e-3);
         assert!(err < 1e-9, "{name}: alphas differ by {err:e}");
         let c_max = coefs_t.amax();

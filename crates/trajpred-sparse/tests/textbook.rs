@@ -91,6 +91,34 @@ fn kkt_per_knot(
         .collect()
 }
 
+/// The design, the target and scikit-learn's KKT violation per knot of case `c`, and the
+/// first knot where that violation exceeds 1e-6 (where scikit-learn leaves the path).
+fn sklearn_deviation(c: &Value) -> (DMatrix<f64>, Vec<f64>, Vec<f64>, usize) {
+    let sk_kkt = vector(&c["kkt_violation"]);
+    let first_bad = sk_kkt
+        .iter()
+        .position(|&v| v > 1e-6)
+        .expect("sklearn deviates");
+    (matrix(&c["x"]), vector(&c["y"]), sk_kkt, first_bad)
+}
+
+/// At its first `knots` knots our path has scikit-learn's standardized coefficients of case
+/// `c` (and, when `alphas`, its alphas), to 1e-9 of the largest.
+fn assert_follows_sklearn(fit: &Lars, c: &Value, knots: usize, alphas: bool) {
+    let sk_alphas = vector(&c["alphas"]);
+    let sk_coefs = matrix(&c["coefs"]);
+    for k in 0..knots {
+        if alphas {
+            assert!(
+                (fit.alphas()[k] - sk_alphas[k]).abs() < 1e-9 * sk_alphas[0],
+                "alpha {k}"
+            );
+        }
+        let d = (fit.standardized_coef_path().row(k) - sk_coefs.row(k)).amax();
+        assert!(d < 1e-9 * sk_coefs.amax(), "knot {k}: {d:e}");
+    }
+}
+
 fn plain(method: Method) -> trajpred_sparse::LarsParams {
     Lars::params()
         .method(method)
@@ -107,24 +135,12 @@ fn sklearn_lar_flips_signs_after_a_zero_crossing_ours_keeps_the_lar_conditions()
     // correlations are no longer equal. The lasso drops column 0 at that point instead.
     let f = fixture();
     let c = case(&f, "sign_flip_lar");
-    let x = matrix(&c["x"]);
-    let y = vector(&c["y"]);
-    let sk_kkt = vector(&c["kkt_violation"]);
-    let first_bad = sk_kkt
-        .iter()
-        .position(|&v| v > 1e-6)
-        .expect("sklearn deviates");
+    let (x, y, sk_kkt, first_bad) = sklearn_deviation(c);
     assert_eq!(first_bad, 4);
 
     let fit = plain(Method::Lar).fit(&x, &y).expect("fit");
     // up to the crossing both follow the same path (1e-9 relative, as for diabetes)
-    let sk_alphas = vector(&c["alphas"]);
-    let sk_coefs = matrix(&c["coefs"]);
-    for k in 0..first_bad {
-        assert!((fit.alphas()[k] - sk_alphas[k]).abs() < 1e-9 * sk_alphas[0]);
-        let d = (fit.standardized_coef_path().row(k) - sk_coefs.row(k)).amax();
-        assert!(d < 1e-9 * sk_coefs.amax(), "knot {k}: {d:e}");
-    }
+    assert_follows_sklearn(&fit, c, first_bad, true);
     // column 0 really changes sign between knots 2 and 3 of our path (LAR allows it)
     let path = fit.coef_path();
     let crossed = path[(2, 0)] < 0.0 && path[(3, 0)] > 0.0;
@@ -150,20 +166,10 @@ fn wide_design_follows_sklearn_until_it_leaves_the_path_then_interpolates() {
     // when the residual correlation vanishes, with 19 active columns and y fitted exactly.
     let f = fixture();
     let c = case(&f, "wide_lar");
-    let x = matrix(&c["x"]);
-    let y = vector(&c["y"]);
-    let sk_kkt = vector(&c["kkt_violation"]);
-    let first_bad = sk_kkt
-        .iter()
-        .position(|&v| v > 1e-6)
-        .expect("sklearn deviates");
+    let (x, y, _, first_bad) = sklearn_deviation(c);
     for gram in [Gram::Auto, Gram::Precompute] {
         let fit = plain(Method::Lar).gram(gram).fit(&x, &y).expect("fit");
-        let sk_coefs = matrix(&c["coefs"]);
-        for k in 0..first_bad {
-            let d = (fit.standardized_coef_path().row(k) - sk_coefs.row(k)).amax();
-            assert!(d < 1e-9 * sk_coefs.amax(), "knot {k}: {d:e}");
-        }
+        assert_follows_sklearn(&fit, c, first_bad, false);
         assert!(kkt_violation(&x, &y, fit.coef_path(), fit.alphas(), false) < 1e-9);
         assert_eq!(fit.stop_reason(), StopReason::CorrelationVanished);
         assert_eq!(fit.active().len(), 19);
@@ -180,7 +186,6 @@ fn wide_lasso_matches_sklearn() {
     let x = matrix(&c["x"]);
     let y = vector(&c["y"]);
     let sk_alphas = vector(&c["alphas"]);
-    let sk_coefs = matrix(&c["coefs"]);
     let fit = plain(Method::Lasso).fit(&x, &y).expect("fit");
     assert!(kkt_violation(&x, &y, fit.coef_path(), fit.alphas(), true) < 1e-9);
     // every knot scikit-learn reports with a non-vanishing alpha is one of ours
@@ -189,14 +194,7 @@ fn wide_lasso_matches_sklearn() {
         .filter(|&&a| a > 1e-10 * sk_alphas[0])
         .count();
     assert!(fit.n_knots() >= knots);
-    for k in 0..knots {
-        assert!(
-            (fit.alphas()[k] - sk_alphas[k]).abs() < 1e-9 * sk_alphas[0],
-            "alpha {k}"
-        );
-        let d = (fit.standardized_coef_path().row(k) - sk_coefs.row(k)).amax();
-        assert!(d < 1e-9 * sk_coefs.amax(), "knot {k}: {d:e}");
-    }
+    assert_follows_sklearn(&fit, c, knots, true);
 }
 
 #[test]

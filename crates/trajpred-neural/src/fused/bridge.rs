@@ -2,14 +2,16 @@
 //! with or without autodiff.
 
 use crate::error::{NeuralError, Result};
+use burn::backend::autodiff::checkpoint::base::Checkpointer;
 use burn::backend::autodiff::checkpoint::strategy::NoCheckpointing;
 use burn::backend::autodiff::grads::Gradients;
-use burn::backend::autodiff::ops::{Backward, NodeGuard, OpsKind};
+use burn::backend::autodiff::ops::{Backward, NodeGuard, Ops, OpsKind};
 use burn::backend::flex::FlexTensor;
 use burn::backend::tensor::FloatTensor;
 use burn::backend::{Autodiff, Flex};
 use burn::tensor::{DType, Tensor, TensorData};
 use std::borrow::Cow;
+use std::marker::PhantomData;
 
 /// An autodiff float primitive of the flex backend.
 pub(crate) type AdTensor = FloatTensor<Autodiff<Flex>>;
@@ -141,5 +143,60 @@ pub(crate) fn register(
 ) {
     if let Some(id) = parent {
         grads.register::<Flex>(*id, flex(grad, shape));
+    }
+}
+
+/// The state a fused op of `N` inputs keeps for its backward step, which knows the inputs'
+/// gradients: with it, [`FusedBackward`] is the op's autodiff node.
+pub(crate) trait FusedState<const N: usize>:
+    Clone + Send + std::fmt::Debug + 'static
+{
+    /// Names the op's output gradient in errors.
+    const WHAT: &'static str;
+
+    /// The shapes of the op's inputs.
+    fn shapes(&self) -> [Vec<usize>; N];
+
+    /// The inputs' gradients (row-major, of [`FusedState::shapes`]) from the output gradient
+    /// `g`; `need[i]` says whether input `i` needs one (an empty vector stands for none).
+    fn gradients(&self, g: &[f32], need: [bool; N]) -> Result<[Vec<f32>; N]>;
+}
+
+/// The autodiff node of a fused op whose state is `S`. Its backward step hands the output
+/// gradient to [`FusedState::gradients`] and registers each input's gradient for its node.
+/// An error there (an internal inconsistency, not reachable with the shapes checked in the
+/// forward pass) registers NaN gradients, which the training loop reports as divergence.
+#[derive(Debug)]
+pub(crate) struct FusedBackward<S>(PhantomData<S>);
+
+impl<S> FusedBackward<S> {
+    /// The node.
+    pub(crate) fn new() -> Self {
+        FusedBackward(PhantomData)
+    }
+}
+
+impl<S: FusedState<N>, const N: usize> Backward<Flex, N> for FusedBackward<S> {
+    type State = S;
+
+    fn backward(self, ops: Ops<S, N>, grads: &mut Gradients, _: &mut Checkpointer) {
+        let Ops {
+            parents,
+            node,
+            state,
+        } = ops;
+        let grad: FlexTensor = grads.consume::<Flex>(&node);
+        let ids = parents.each_ref().map(|p| p.as_ref().map(|n| n.id));
+        let shapes = state.shapes();
+        let result = values(&grad, S::WHAT)
+            .and_then(|g| state.gradients(&g, ids.each_ref().map(Option::is_some)));
+        let parts = result.unwrap_or_else(|_| {
+            shapes
+                .each_ref()
+                .map(|shape| vec![f32::NAN; shape.iter().product()])
+        });
+        for ((id, g), shape) in ids.iter().zip(parts).zip(&shapes) {
+            register(grads, id.as_ref(), g, shape);
+        }
     }
 }

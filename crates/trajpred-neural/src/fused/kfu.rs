@@ -15,10 +15,6 @@ use super::bridge;
 use super::{Mat, Real, add_column_sums, cell_backward, cell_forward, gemm};
 use crate::config::Activation;
 use crate::error::{NeuralError, Result};
-use burn::backend::Flex;
-use burn::backend::autodiff::checkpoint::base::Checkpointer;
-use burn::backend::autodiff::grads::Gradients;
-use burn::backend::autodiff::ops::{Backward, Ops};
 use burn::backend::flex::FlexTensor;
 use burn::tensor::Tensor;
 
@@ -569,46 +565,18 @@ pub(crate) struct State {
     params: Vec<f32>,
 }
 
-/// The autodiff node of the fused filter (parents: `z`, the packed parameters).
-#[derive(Debug)]
-struct SequenceBackward;
+/// The fused filter's inputs: `z`, the packed parameters.
+impl bridge::FusedState<2> for State {
+    const WHAT: &'static str = "KFU output gradient";
 
-impl Backward<Flex, 2> for SequenceBackward {
-    type State = State;
+    fn shapes(&self) -> [Vec<usize>; 2] {
+        let (batch, c, d) = (self.cache.batch, self.cache.c, self.spec.d);
+        [vec![batch, c, d], vec![self.params.len()]]
+    }
 
-    fn backward(self, ops: Ops<State, 2>, grads: &mut Gradients, _: &mut Checkpointer) {
-        let Ops {
-            parents,
-            node,
-            state,
-        } = ops;
-        let grad: FlexTensor = grads.consume::<Flex>(&node);
-        let [z_id, p_id] = parents.each_ref().map(|p| p.as_ref().map(|n| n.id));
-        let (batch, c, d) = (state.cache.batch, state.cache.c, state.spec.d);
-        let result = bridge::values(&grad, "KFU output gradient").and_then(|g| {
-            backward(
-                &state.spec,
-                &state.cache,
-                &state.z,
-                &state.params,
-                &g,
-                z_id.is_some(),
-            )
-        });
-        // An internal inconsistency (not reachable with the shapes checked in the forward
-        // pass) leaves NaN gradients, which the training loop reports as divergence.
-        let g = result.unwrap_or_else(|_| Grads {
-            params: vec![f32::NAN; state.params.len()],
-            z: Some(vec![f32::NAN; batch * c * d]),
-        });
-        bridge::register(
-            grads,
-            z_id.as_ref(),
-            g.z.unwrap_or_default(),
-            &[batch, c, d],
-        );
-        let n = g.params.len();
-        bridge::register(grads, p_id.as_ref(), g.params, &[n]);
+    fn gradients(&self, g: &[f32], [need_z, _]: [bool; 2]) -> Result<[Vec<f32>; 2]> {
+        let g = backward(&self.spec, &self.cache, &self.z, &self.params, g, need_z)?;
+        Ok([g.z.unwrap_or_default(), g.params])
     }
 }
 
@@ -651,5 +619,11 @@ pub(crate) fn sequence(
             },
         ))
     };
-    bridge::apply(SequenceBackward, prims, &shape, "fused KFU", run)
+    bridge::apply(
+        bridge::FusedBackward::<State>::new(),
+        prims,
+        &shape,
+        "fused KFU",
+        run,
+    )
 }

@@ -9,10 +9,6 @@
 use super::bridge;
 use super::{Mat, Real, add_column_sums, cell_backward, cell_forward, gemm};
 use crate::error::{NeuralError, Result};
-use burn::backend::Flex;
-use burn::backend::autodiff::checkpoint::base::Checkpointer;
-use burn::backend::autodiff::grads::Gradients;
-use burn::backend::autodiff::ops::{Backward, Ops};
 use burn::backend::flex::FlexTensor;
 use burn::tensor::Tensor;
 
@@ -257,58 +253,28 @@ pub(crate) struct State {
     w_hh: Vec<f32>,
 }
 
-/// The autodiff node of a fused LSTM layer (parents: `x`, `W_ih`, `b`, `W_hh`).
-#[derive(Debug)]
-struct LayerBackward;
+/// A fused LSTM layer's inputs: `x`, `W_ih`, `b`, `W_hh`.
+impl bridge::FusedState<4> for State {
+    const WHAT: &'static str = "LSTM output gradient";
 
-impl Backward<Flex, 4> for LayerBackward {
-    type State = State;
-
-    fn backward(self, ops: Ops<State, 4>, grads: &mut Gradients, _: &mut Checkpointer) {
-        let Ops {
-            parents,
-            node,
-            state,
-        } = ops;
-        let grad: FlexTensor = grads.consume::<Flex>(&node);
+    fn shapes(&self) -> [Vec<usize>; 4] {
         let Dims {
             batch,
             steps,
             input,
             hidden,
-        } = state.cache.dims;
-        let ids = parents.each_ref().map(|p| p.as_ref().map(|n| n.id));
-        let shapes: [Vec<usize>; 4] = [
+        } = self.cache.dims;
+        [
             vec![batch, steps, input],
             vec![input, 4 * hidden],
             vec![4 * hidden],
             vec![hidden, 4 * hidden],
-        ];
-        let result = bridge::values(&grad, "LSTM output gradient").and_then(|dh| {
-            backward(
-                &state.cache,
-                &state.w_ih,
-                &state.w_hh,
-                &dh,
-                ids[0].is_some(),
-            )
-        });
-        // An internal inconsistency (not reachable with the shapes checked in the forward
-        // pass) leaves NaN gradients, which the training loop reports as divergence.
-        let g = result.unwrap_or_else(|_| {
-            let nan = |n: usize| vec![f32::NAN; n];
-            Grads {
-                dx: Some(nan(batch * steps * input)),
-                dw_ih: nan(input * 4 * hidden),
-                db: nan(4 * hidden),
-                dw_hh: nan(hidden * 4 * hidden),
-            }
-        });
-        let dx = g.dx.unwrap_or_default();
-        let parts = [dx, g.dw_ih, g.db, g.dw_hh];
-        for ((id, grad), shape) in ids.iter().zip(parts).zip(&shapes) {
-            bridge::register(grads, id.as_ref(), grad, shape);
-        }
+        ]
+    }
+
+    fn gradients(&self, dh: &[f32], [need_x, ..]: [bool; 4]) -> Result<[Vec<f32>; 4]> {
+        let g = backward(&self.cache, &self.w_ih, &self.w_hh, dh, need_x)?;
+        Ok([g.dx.unwrap_or_default(), g.dw_ih, g.db, g.dw_hh])
     }
 }
 
@@ -353,5 +319,11 @@ pub(crate) fn layer(
             },
         ))
     };
-    bridge::apply(LayerBackward, prims, &shape, "fused LSTM", run)
+    bridge::apply(
+        bridge::FusedBackward::<State>::new(),
+        prims,
+        &shape,
+        "fused LSTM",
+        run,
+    )
 }

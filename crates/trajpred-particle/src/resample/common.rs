@@ -2,6 +2,7 @@
 //! the binary search.
 
 use crate::error::{ParticleError, Result};
+use trajpred_core::Error as CoreError;
 
 /// Validated weights: their sum, the index of the last positive weight, and the running sum
 /// at the midpoint (`mid`, a multiple of 4: the sum of `weights[..mid]`, accumulated in the
@@ -41,7 +42,7 @@ pub(super) fn sum_and_sign(weights: &[f64], total: &mut f64, negative: &mut bool
 /// the counts read from it garbage).
 pub(super) fn check_weights(weights: &[f64], n: usize) -> Result<Checked> {
     if weights.is_empty() {
-        return Err(ParticleError::Empty { what: "weights" });
+        return Err(CoreError::Empty { what: "weights" }.into());
     }
     // Fast pass: the sequential sum (the `C_(N-1)` the cumulative sums of the merge passes
     // end with) and a flag for negative weights; a NaN or infinite weight makes the sum
@@ -59,10 +60,11 @@ pub(super) fn check_weights(weights: &[f64], n: usize) -> Result<Checked> {
             }
         }
         if !total.is_finite() {
-            return Err(ParticleError::NonFinite {
+            return Err(CoreError::NonFinite {
                 what: "sum of weights",
                 index: 0,
-            });
+            }
+            .into());
         }
     }
     // non-negative weights with a zero sum are all zero

@@ -62,10 +62,10 @@ pub trait Resampler {
     /// Writes `out.len()` ancestor indices drawn according to `weights` (non-negative, not
     /// necessarily normalised) into `out`, without allocating.
     ///
-    /// Errors: [`ParticleError::Empty`](crate::ParticleError::Empty) (no weights), [`ParticleError::InvalidWeight`](crate::ParticleError::InvalidWeight)
+    /// Errors: [`trajpred_core::Error::Empty`] (no weights), [`ParticleError::InvalidWeight`](crate::ParticleError::InvalidWeight)
     /// (negative or non-finite), [`ParticleError::AllWeightsZero`](crate::ParticleError::AllWeightsZero) (also for weights that
     /// underflowed: a total that is subnormal or below `n / f64::MAX`),
-    /// [`ParticleError::NonFinite`](crate::ParticleError::NonFinite) (the sum of the weights overflows).
+    /// [`trajpred_core::Error::NonFinite`] (the sum of the weights overflows).
     fn resample_into<R: Rng + ?Sized>(
         &self,
         weights: &[f64],

@@ -2,10 +2,11 @@
 
 use super::Resampler;
 use super::common::*;
-use super::residual::{PARTS_MAX, Part, part_count, resample_scaled, residual_total};
-use crate::error::{ParticleError, Result};
+use super::residual::{resample_scaled, with_parts};
+use crate::error::Result;
 use rand::Rng;
 use rand_distr::{Distribution, Exp1};
+use trajpred_core::Error as CoreError;
 
 /// Multinomial resampling for given uniforms `u_j in [0, 1]`, one draw per uniform, in the
 /// order of the uniforms (the inverse of the cumulative distribution at each `u_j`; this
@@ -17,11 +18,12 @@ use rand_distr::{Distribution, Exp1};
 pub fn multinomial_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) -> Result<()> {
     let c = check_weights(weights, out.len())?;
     if uniforms.len() != out.len() {
-        return Err(ParticleError::LengthMismatch {
+        return Err(CoreError::LengthMismatch {
             what: "uniforms vs output",
             expected: out.len(),
             got: uniforms.len(),
-        });
+        }
+        .into());
     }
     let mut cumsum = Vec::with_capacity(weights.len());
     let mut s = 0.0;
@@ -134,26 +136,23 @@ impl Resampler for Multinomial {
         rng: &mut R,
         out: &mut [usize],
     ) -> Result<()> {
-        let n = out.len();
-        let mut parts = [Part::default(); PARTS_MAX];
-        let parts = &mut parts[..part_count(weights.len())];
-        let total = residual_total(weights, parts, n)?;
-        let most = match parts {
-            [_] => weights
-                .iter()
-                .fold(0.0f64, |a, &w| if w > a { w } else { a }),
-            _ => parts.iter().fold(0.0f64, |a, p| p.max.max(a)),
-        };
-        // below 1 / max w_i (by more than its rounding): every w_i scale is in [0, 1)
-        let scale = (1.0 - f64::EPSILON * 64.0) / most;
-        if scale.is_finite() {
-            resample_scaled(weights, parts, scale, rng, out);
-        } else {
-            // a subnormal largest weight: the sorted uniforms, at the weights' own scale
-            let last = weights.iter().rposition(|&w| w > 0.0).unwrap_or(0);
-            sorted_multinomial(rng, |i| weights[i], weights.len(), total, last, out);
-        }
-        Ok(())
+        with_parts(weights, out.len(), |parts, total| {
+            let most = match parts {
+                [_] => weights
+                    .iter()
+                    .fold(0.0f64, |a, &w| if w > a { w } else { a }),
+                _ => parts.iter().fold(0.0f64, |a, p| p.max.max(a)),
+            };
+            // below 1 / max w_i (by more than its rounding): every w_i scale is in [0, 1)
+            let scale = (1.0 - f64::EPSILON * 64.0) / most;
+            if scale.is_finite() {
+                resample_scaled(weights, parts, scale, rng, out);
+            } else {
+                // a subnormal largest weight: the sorted uniforms, at the weights' own scale
+                let last = weights.iter().rposition(|&w| w > 0.0).unwrap_or(0);
+                sorted_multinomial(rng, |i| weights[i], weights.len(), total, last, out);
+            }
+        })
     }
     fn name(&self) -> &'static str {
         "multinomial"

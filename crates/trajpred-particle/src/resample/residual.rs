@@ -5,10 +5,11 @@ use super::Resampler;
 use super::blocks::residual_blocks;
 use super::common::*;
 use super::multinomial::sorted_multinomial;
-use crate::error::{ParticleError, Result};
+use crate::error::Result;
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{Rng, SeedableRng};
 use rand_distr::Distribution;
+use trajpred_core::Error as CoreError;
 
 /// Residual resampling for given uniforms (allocates the residual cumulative sums): the
 /// first `k = sum_i floor(n w_i)` outputs are the deterministic copies in index order, the
@@ -36,11 +37,12 @@ pub fn residual_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) ->
     let (k, _, _) = write_copies(weights, scale, out);
     let m = n - k;
     if uniforms.len() < m {
-        return Err(ParticleError::LengthMismatch {
+        return Err(CoreError::LengthMismatch {
             what: "uniforms vs remainder draws",
             expected: m,
             got: uniforms.len(),
-        });
+        }
+        .into());
     }
     if m == 0 {
         return Ok(k);
@@ -136,11 +138,9 @@ impl Resampler for Residual {
         out: &mut [usize],
     ) -> Result<()> {
         let n = out.len();
-        let mut parts = [Part::default(); PARTS_MAX];
-        let parts = &mut parts[..part_count(weights.len())];
-        let scale = n as f64 / residual_total(weights, parts, n)?;
-        resample_scaled(weights, parts, scale, rng, out);
-        Ok(())
+        with_parts(weights, n, |parts, total| {
+            resample_scaled(weights, parts, n as f64 / total, rng, out);
+        })
     }
     fn name(&self) -> &'static str {
         "residual"
@@ -313,6 +313,20 @@ pub(super) fn part_count(len: usize) -> usize {
     } else {
         (len / PART_MIN).clamp(2, PARTS_MAX)
     }
+}
+
+/// The start both the residual and the multinomial scheme share: checks `weights`, cuts them
+/// into [`part_count`] parts and sums them ([`residual_total`]), then hands the parts and
+/// the total `W` to `then`.
+pub(super) fn with_parts<T>(
+    weights: &[f64],
+    n: usize,
+    then: impl FnOnce(&mut [Part], f64) -> T,
+) -> Result<T> {
+    let mut parts = [Part::default(); PARTS_MAX];
+    let parts = &mut parts[..part_count(weights.len())];
+    let total = residual_total(weights, parts, n)?;
+    Ok(then(parts, total))
 }
 
 /// Checks the weights and returns their sum `W`, after cutting `0..len` into

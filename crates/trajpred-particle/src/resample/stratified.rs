@@ -2,8 +2,9 @@
 
 use super::Resampler;
 use super::common::*;
-use crate::error::{ParticleError, Result};
+use crate::error::Result;
 use rand::Rng;
+use trajpred_core::Error as CoreError;
 
 /// The merge pass: for non-decreasing positions `pos(j)` (in units of the weights), writes
 /// the index `i` with `C_(i-1) <= pos(j) < C_i` into `out[j]`; positions at or beyond the
@@ -28,16 +29,17 @@ pub(super) fn merge_sorted(
 }
 
 /// Stratified resampling for given uniforms `u_j in [0, 1]` (one per output): positions
-/// `(j + u_j) / n`. Errors with [`ParticleError::LengthMismatch`] unless
-/// `uniforms.len() == out.len()`, [`ParticleError::InvalidUniform`] outside `[0, 1]`.
+/// `(j + u_j) / n`. Errors with [`trajpred_core::Error::LengthMismatch`] unless
+/// `uniforms.len() == out.len()`, [`ParticleError::InvalidUniform`](crate::ParticleError::InvalidUniform) outside `[0, 1]`.
 pub fn stratified_indices(weights: &[f64], uniforms: &[f64], out: &mut [usize]) -> Result<()> {
     let c = check_weights(weights, out.len())?;
     if uniforms.len() != out.len() {
-        return Err(ParticleError::LengthMismatch {
+        return Err(CoreError::LengthMismatch {
             what: "uniforms vs output",
             expected: out.len(),
             got: uniforms.len(),
-        });
+        }
+        .into());
     }
     for (i, &u) in uniforms.iter().enumerate() {
         check_uniform(i, u)?;

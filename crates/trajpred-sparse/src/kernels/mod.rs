@@ -140,7 +140,25 @@ fn dots_into<S: Simd>(
     }
 }
 
-struct Dots<'a> {
+/// Which kernel [`OverColumns`] runs over all the rows.
+#[derive(Clone, Copy)]
+enum ColumnKernel<'a> {
+    /// [`dots_into`]: `out[k] = x_{cols[k]} . v`.
+    Dots,
+    /// [`combine_into`]: `out = sum_k v[k] x_{cols[k]}`.
+    Combine,
+    /// [`residual_dots_into`]: `out = X_S^T (y - X_S v)`.
+    ResidualDots {
+        /// The target `y`.
+        y: &'a [f64],
+    },
+}
+
+/// A kernel over the columns `cols` of the column-major `data` (`n` rows) with one operand
+/// vector `v`, dispatched to the CPU's SIMD: the frame [`dots`], [`combine`] and
+/// [`residual_dots`] share.
+struct OverColumns<'a> {
+    kernel: ColumnKernel<'a>,
     data: &'a [f64],
     n: usize,
     cols: &'a [usize],
@@ -148,18 +166,25 @@ struct Dots<'a> {
     out: &'a mut [f64],
 }
 
-impl WithSimd for Dots<'_> {
+impl WithSimd for OverColumns<'_> {
     type Output = ();
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) {
-        let Dots {
+        let OverColumns {
+            kernel,
             data,
             n,
             cols,
             v,
             out,
         } = self;
-        dots_into(simd, (data, n), cols, (0, n), v, out);
+        match kernel {
+            ColumnKernel::Dots => dots_into(simd, (data, n), cols, (0, n), v, out),
+            ColumnKernel::Combine => combine_into(simd, (data, n), cols, (0, n), v, out),
+            ColumnKernel::ResidualDots { y } => {
+                residual_dots_into(simd, (data, n), cols, v, y, out)
+            }
+        }
     }
 }
 
@@ -168,7 +193,8 @@ impl WithSimd for Dots<'_> {
 pub(crate) fn dots(data: &[f64], n: usize, cols: &[usize], v: &[f64], out: &mut [f64]) {
     debug_assert_eq!(v.len(), n);
     debug_assert_eq!(out.len(), cols.len());
-    arch().dispatch(Dots {
+    arch().dispatch(OverColumns {
+        kernel: ColumnKernel::Dots,
         data,
         n,
         cols,
@@ -179,14 +205,6 @@ pub(crate) fn dots(data: &[f64], n: usize, cols: &[usize], v: &[f64], out: &mut 
 
 // ---------------------------------------------------------------------------------------
 // X_S w
-
-struct Combine<'a> {
-    data: &'a [f64],
-    n: usize,
-    cols: &'a [usize],
-    w: &'a [f64],
-    out: &'a mut [f64],
-}
 
 /// `out = sum_k w[k] x_{cols[k]}[rows]` (`out.len()` = the number of rows).
 #[inline(always)]
@@ -230,21 +248,6 @@ fn combine_into<S: Simd>(
     }
 }
 
-impl WithSimd for Combine<'_> {
-    type Output = ();
-    #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) {
-        let Combine {
-            data,
-            n,
-            cols,
-            w,
-            out,
-        } = self;
-        combine_into(simd, (data, n), cols, (0, n), w, out);
-    }
-}
-
 // ---------------------------------------------------------------------------------------
 // X_S^T (y - X_S b) in one pass over X_S
 
@@ -252,44 +255,32 @@ impl WithSimd for Combine<'_> {
 /// its two uses.
 const RESIDUAL_ROWS: usize = 512;
 
-struct ResidualDots<'a> {
-    data: &'a [f64],
-    n: usize,
-    cols: &'a [usize],
-    b: &'a [f64],
-    y: &'a [f64],
-    out: &'a mut [f64],
-}
-
-impl WithSimd for ResidualDots<'_> {
-    type Output = ();
-    #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) {
-        let ResidualDots {
-            data,
-            n,
-            cols,
-            b,
-            y,
-            out,
-        } = self;
-        out.fill(0.0);
-        let mut r = vec![0.0; RESIDUAL_ROWS.min(n)];
-        let mut part = vec![0.0; cols.len()];
-        let mut r0 = 0;
-        while r0 < n {
-            let r1 = (r0 + RESIDUAL_ROWS).min(n);
-            let rb = &mut r[..r1 - r0];
-            combine_into(simd, (data, n), cols, (r0, r1), b, rb);
-            for (ri, yi) in rb.iter_mut().zip(&y[r0..r1]) {
-                *ri = yi - *ri;
-            }
-            dots_into(simd, (data, n), cols, (r0, r1), rb, &mut part);
-            for (o, q) in out.iter_mut().zip(&part) {
-                *o += q;
-            }
-            r0 = r1;
+/// `out = X_S^T (y - X_S b)` by blocks of [`RESIDUAL_ROWS`] rows.
+#[inline(always)]
+fn residual_dots_into<S: Simd>(
+    simd: S,
+    (data, n): (&[f64], usize),
+    cols: &[usize],
+    b: &[f64],
+    y: &[f64],
+    out: &mut [f64],
+) {
+    out.fill(0.0);
+    let mut r = vec![0.0; RESIDUAL_ROWS.min(n)];
+    let mut part = vec![0.0; cols.len()];
+    let mut r0 = 0;
+    while r0 < n {
+        let r1 = (r0 + RESIDUAL_ROWS).min(n);
+        let rb = &mut r[..r1 - r0];
+        combine_into(simd, (data, n), cols, (r0, r1), b, rb);
+        for (ri, yi) in rb.iter_mut().zip(&y[r0..r1]) {
+            *ri = yi - *ri;
         }
+        dots_into(simd, (data, n), cols, (r0, r1), rb, &mut part);
+        for (o, q) in out.iter_mut().zip(&part) {
+            *o += q;
+        }
+        r0 = r1;
     }
 }
 
@@ -306,12 +297,12 @@ pub(crate) fn residual_dots(
     debug_assert_eq!(y.len(), n);
     debug_assert_eq!(b.len(), cols.len());
     debug_assert_eq!(out.len(), cols.len());
-    arch().dispatch(ResidualDots {
+    arch().dispatch(OverColumns {
+        kernel: ColumnKernel::ResidualDots { y },
         data,
         n,
         cols,
-        b,
-        y,
+        v: b,
         out,
     });
 }
@@ -321,11 +312,12 @@ pub(crate) fn residual_dots(
 pub(crate) fn combine(data: &[f64], n: usize, cols: &[usize], w: &[f64], out: &mut [f64]) {
     debug_assert_eq!(out.len(), n);
     debug_assert_eq!(w.len(), cols.len());
-    arch().dispatch(Combine {
+    arch().dispatch(OverColumns {
+        kernel: ColumnKernel::Combine,
         data,
         n,
         cols,
-        w,
+        v: w,
         out,
     });
 }

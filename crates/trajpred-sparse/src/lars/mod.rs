@@ -154,67 +154,34 @@ impl Default for LarsParams {
 }
 
 impl LarsParams {
-    /// LAR or lasso.
-    pub fn method(mut self, method: Method) -> Self {
-        self.method = method;
-        self
-    }
-
-    /// Fit an intercept (centre the columns and the target). Default `true`.
-    pub fn fit_intercept(mut self, yes: bool) -> Self {
-        self.fit_intercept = yes;
-        self
-    }
-
-    /// Scale every (centred, if `fit_intercept`) column to unit L2 norm before the path.
-    /// Default `true`. Alphas and [`Lars::standardized_coef_path`] refer to the scaled
-    /// problem; [`Lars::coef_path`] is always on the original scale.
-    pub fn normalize(mut self, yes: bool) -> Self {
-        self.normalize = yes;
-        self
-    }
-
-    /// Stop after `steps` steps (a step moves from one knot to the next; the path then has at
-    /// most `steps + 1` knots). Default: no limit.
-    pub fn max_steps(mut self, steps: usize) -> Self {
-        self.max_steps = Some(steps);
-        self
-    }
-
-    /// Stop when alpha (the largest absolute residual correlation divided by the number of
-    /// rows, scikit-learn's convention) reaches `alpha_min`; the last knot is interpolated
-    /// to exactly `alpha_min`. Default `0` (no stop). Must be finite and non-negative.
-    pub fn alpha_min(mut self, alpha: f64) -> Self {
-        self.alpha_min = alpha;
-        self
-    }
-
-    /// Variables whose absolute correlation is within `tol * C` of the maximum `C` enter
-    /// together at the same knot (R `lars`'s rule). Default `1e-12`, in `[0, 1e-3]`.
-    pub fn tie_tolerance(mut self, tol: f64) -> Self {
-        self.tie_tolerance = tol;
-        self
-    }
-
-    /// A column whose part orthogonal to the active columns has squared norm at most
-    /// `tol * ||x_j||^2` is collinear and excluded for good. Default `1e-12` (the angle to
-    /// the active span below about 1e-6 rad), in `[0, 1e-2]`.
-    pub fn collinearity_tolerance(mut self, tol: f64) -> Self {
-        self.collinearity_tolerance = tol;
-        self
-    }
-
-    /// The path stops when the largest residual correlation falls to `tol` times its
-    /// starting value. Default `1e-12`, in `[0, 1e-3]`.
-    pub fn vanish_tolerance(mut self, tol: f64) -> Self {
-        self.vanish_tolerance = tol;
-        self
-    }
-
-    /// Gram matrix policy (speed only; the path is the same up to rounding).
-    pub fn gram(mut self, gram: Gram) -> Self {
-        self.gram = gram;
-        self
+    setters! {
+        /// LAR or lasso.
+        method(method: Method) => self.method = method;
+        /// Fit an intercept (centre the columns and the target). Default `true`.
+        fit_intercept(yes: bool) => self.fit_intercept = yes;
+        /// Scale every (centred, if `fit_intercept`) column to unit L2 norm before the path.
+        /// Default `true`. Alphas and [`Lars::standardized_coef_path`] refer to the scaled
+        /// problem; [`Lars::coef_path`] is always on the original scale.
+        normalize(yes: bool) => self.normalize = yes;
+        /// Stop after `steps` steps (a step moves from one knot to the next; the path then has at
+        /// most `steps + 1` knots). Default: no limit.
+        max_steps(steps: usize) => self.max_steps = Some(steps);
+        /// Stop when alpha (the largest absolute residual correlation divided by the number of
+        /// rows, scikit-learn's convention) reaches `alpha_min`; the last knot is interpolated
+        /// to exactly `alpha_min`. Default `0` (no stop). Must be finite and non-negative.
+        alpha_min(alpha: f64) => self.alpha_min = alpha;
+        /// Variables whose absolute correlation is within `tol * C` of the maximum `C` enter
+        /// together at the same knot (R `lars`'s rule). Default `1e-12`, in `[0, 1e-3]`.
+        tie_tolerance(tol: f64) => self.tie_tolerance = tol;
+        /// A column whose part orthogonal to the active columns has squared norm at most
+        /// `tol * ||x_j||^2` is collinear and excluded for good. Default `1e-12` (the angle to
+        /// the active span below about 1e-6 rad), in `[0, 1e-2]`.
+        collinearity_tolerance(tol: f64) => self.collinearity_tolerance = tol;
+        /// The path stops when the largest residual correlation falls to `tol` times its
+        /// starting value. Default `1e-12`, in `[0, 1e-3]`.
+        vanish_tolerance(tol: f64) => self.vanish_tolerance = tol;
+        /// Gram matrix policy (speed only; the path is the same up to rounding).
+        gram(gram: Gram) => self.gram = gram;
     }
 
     fn validate(&self) -> Result<()> {

@@ -30,27 +30,18 @@ impl Default for LarsPathOptions {
 }
 
 impl LarsPathOptions {
-    /// At most `max_iter` steps, so at most `max_iter + 1` alphas (scikit-learn's
-    /// `max_iter`, default 500). `usize::MAX` means no limit.
-    pub fn max_iter(mut self, max_iter: usize) -> Self {
-        self.max_iter = max_iter;
-        self
-    }
-
-    /// Stop at this alpha; the last knot is interpolated to exactly `alpha_min`
-    /// (scikit-learn's `alpha_min`, default 0). Must be finite and non-negative.
-    pub fn alpha_min(mut self, alpha_min: f64) -> Self {
-        self.alpha_min = alpha_min;
-        self
-    }
-
-    /// Whether to precompute `X^T X` (speed only). scikit-learn's `Gram=None` computes
-    /// without it and `Gram='auto'` with it when `n_samples > n_features`; the default here
-    /// is [`Gram::Auto`] (with it when `p <= n`), the faster choice, which gives the same
-    /// path up to rounding.
-    pub fn gram(mut self, gram: Gram) -> Self {
-        self.gram = gram;
-        self
+    setters! {
+        /// At most `max_iter` steps, so at most `max_iter + 1` alphas (scikit-learn's
+        /// `max_iter`, default 500). `usize::MAX` means no limit.
+        max_iter(max_iter: usize) => self.max_iter = max_iter;
+        /// Stop at this alpha; the last knot is interpolated to exactly `alpha_min`
+        /// (scikit-learn's `alpha_min`, default 0). Must be finite and non-negative.
+        alpha_min(alpha_min: f64) => self.alpha_min = alpha_min;
+        /// Whether to precompute `X^T X` (speed only). scikit-learn's `Gram=None` computes
+        /// without it and `Gram='auto'` with it when `n_samples > n_features`; the default here
+        /// is [`Gram::Auto`] (with it when `p <= n`), the faster choice, which gives the same
+        /// path up to rounding.
+        gram(gram: Gram) => self.gram = gram;
     }
 
     /// The step limit.

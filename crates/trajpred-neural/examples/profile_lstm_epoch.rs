@@ -4,7 +4,7 @@
 //! loss. On a loaded machine, `perf stat -e instructions:u` over this run is a steadier
 //! yardstick than wall time.
 //!
-//! `cargo run --release -p trajpred-neural --example lstm_epoch -- [epochs]`
+//! `cargo run --release -p trajpred-neural --example profile_lstm_epoch -- [epochs]`
 
 use trajpred_core::Trajectory;
 use trajpred_neural::{AxisMode, LstmArch, LstmNet, RecurrentLayers, TrainConfig, WindowConfig};

@@ -1,7 +1,7 @@
 //! Times a few epochs of every preset at the papers' data sizes and extrapolates to the full
 //! epoch counts, so the reproduction can budget its run time.
 //!
-//! `cargo run --release -p trajpred-neural --example preset_timing -- [epochs]`
+//! `cargo run --release -p trajpred-neural --example profile_preset_timing -- [epochs]`
 
 use std::time::Instant;
 use trajpred_core::Trajectory;
@@ -56,6 +56,23 @@ fn report(name: &str, epochs: usize, full: usize, secs: f64) {
     );
 }
 
+/// Trains the preset `$model` for `$epochs` epochs with `$fit` (`fit_with`, or
+/// `fit_observed` for the KFU net) on `$data`, reports the time per epoch and the
+/// extrapolation to the preset's own epoch count as `$name`, and gives back the model.
+/// (A macro: the presets are different types with the same inherent methods.)
+macro_rules! time_preset {
+    ($name:expr, $model:expr, $fit:ident, $data:expr, $epochs:expr) => {{
+        let mut model = $model;
+        let full = model.train_config().epochs;
+        let cfg: TrainConfig = model.train_config().clone().with_epochs($epochs);
+        model.set_train_config(cfg)?;
+        let s = Instant::now();
+        model.$fit($data, &mut |_| {})?;
+        report($name, $epochs, full, s.elapsed().as_secs_f64());
+        model
+    }};
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let epochs: usize = std::env::args()
         .nth(1)
@@ -65,60 +82,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let gskf = vec![eq20(1000).prefix(800)?];
     let patent = vec![helix(1000).prefix(800)?];
 
-    let mut bp = Mlp::gskf_bp(6, 6)?;
-    let full = bp.train_config().epochs;
-    bp.set_train_config(bp.train_config().clone().with_epochs(epochs))?;
-    let s = Instant::now();
-    bp.fit_with(&gskf, &mut |_| {})?;
-    report("GSKF BP (3 axes)", epochs, full, s.elapsed().as_secs_f64());
-
-    let mut lstm = LstmNet::gskf_lstm(6, 6)?;
-    let full = lstm.train_config().epochs;
-    lstm.set_train_config(lstm.train_config().clone().with_epochs(epochs))?;
-    let s = Instant::now();
-    lstm.fit_with(&gskf, &mut |_| {})?;
-    report(
-        "GSKF LSTM (3 axes)",
-        epochs,
-        full,
-        s.elapsed().as_secs_f64(),
-    );
-
-    let mut rnn = RnnNet::patent_baseline(10, 1)?;
-    let full = rnn.train_config().epochs;
-    rnn.set_train_config(rnn.train_config().clone().with_epochs(epochs))?;
-    let s = Instant::now();
-    rnn.fit_with(&patent, &mut |_| {})?;
-    report(
-        "patent RNN (800 pts)",
-        epochs,
-        full,
-        s.elapsed().as_secs_f64(),
-    );
-
-    let mut lstm = LstmNet::patent_baseline(10, 1)?;
-    let full = lstm.train_config().epochs;
-    lstm.set_train_config(lstm.train_config().clone().with_epochs(epochs))?;
-    let s = Instant::now();
-    lstm.fit_with(&patent, &mut |_| {})?;
-    report(
-        "patent LSTM (800 pts)",
-        epochs,
-        full,
-        s.elapsed().as_secs_f64(),
-    );
-
-    let mut kfu = KfuLstmNet::patent()?;
-    let full = kfu.train_config().epochs;
-    let cfg: TrainConfig = kfu.train_config().clone().with_epochs(epochs);
-    kfu.set_train_config(cfg)?;
-    let s = Instant::now();
-    kfu.fit_observed(&patent, &mut |_| {})?;
-    report(
+    let bp = Mlp::gskf_bp(6, 6)?;
+    time_preset!("GSKF BP (3 axes)", bp, fit_with, &gskf, epochs);
+    let lstm = LstmNet::gskf_lstm(6, 6)?;
+    time_preset!("GSKF LSTM (3 axes)", lstm, fit_with, &gskf, epochs);
+    let rnn = RnnNet::patent_baseline(10, 1)?;
+    time_preset!("patent RNN (800 pts)", rnn, fit_with, &patent, epochs);
+    let lstm = LstmNet::patent_baseline(10, 1)?;
+    time_preset!("patent LSTM (800 pts)", lstm, fit_with, &patent, epochs);
+    let kfu = KfuLstmNet::patent()?;
+    let kfu = time_preset!(
         "patent KFU-LSTM (800 pts)",
-        epochs,
-        full,
-        s.elapsed().as_secs_f64(),
+        kfu,
+        fit_observed,
+        &patent,
+        epochs
     );
     let s = Instant::now();
     let p = kfu.one_step_ahead(&helix(200))?;

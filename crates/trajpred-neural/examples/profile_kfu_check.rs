@@ -1,7 +1,7 @@
 //! A quick check of the KFU-LSTM-Net on a noisy helix: one-step-ahead RMSE against the clean
 //! truth, beside the persistence forecast and the LSTM baseline.
 //!
-//! `cargo run --release -p trajpred-neural --example kfu_check -- [epochs]`
+//! `cargo run --release -p trajpred-neural --example profile_kfu_check -- [epochs]`
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

@@ -3,7 +3,7 @@
 //! weights, for a shared machine where criterion's wall-clock figures include time the
 //! threads spent descheduled; after each scheme, a hash of its last output, to compare the
 //! indices of two builds (same `N` and `REPS`, so the same draws). Usage:
-//! `cargo run --release -p trajpred-particle --example resample_cpu_time -- N REPS`
+//! `cargo run --release -p trajpred-particle --example profile_resample_cpu_time -- N REPS`
 //! (`EXPT=1`: cost of one Exp(1) / one uniform draw with a running sum; `SCHEME=name`: only
 //! that scheme, e.g. for `perf record`).
 use rand::rngs::SmallRng;
