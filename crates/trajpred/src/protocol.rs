@@ -354,24 +354,38 @@ pub fn run(
     if let Some(n) = protocol.max_test {
         test.truncate(n);
     }
+    run_split(protocol, segments.len(), train, test, progress)
+}
+
+/// [`run`] on a split already made: fits on `train` (each method told the segments' groups,
+/// [`Predictor::fit_grouped`]) and evaluates on `test`. `segments` (how many there were
+/// before the split) only words the error for an empty test part.
+fn run_split(
+    protocol: &Protocol,
+    segments: usize,
+    train: Vec<Segment>,
+    test: Vec<Segment>,
+    progress: &dyn Progress,
+) -> Result<ProtocolRun> {
     if test.is_empty() {
         return Err(Error::InvalidParameter {
             name: "segments",
             reason: format!(
                 "{} segments of at least {} points: too few for a test part",
-                segments.len(),
+                segments,
                 protocol.segmentation.min_points
             ),
         });
     }
     let train_tr: Vec<Trajectory> = train.iter().map(|s| s.trajectory.clone()).collect();
+    let groups = harness::group_ids(&train);
     let mut predictors = Vec::with_capacity(protocol.methods.len());
     let mut fit_seconds = Vec::with_capacity(protocol.methods.len());
     for m in &protocol.methods {
         let mut p = build(&m.name, &m.options)?;
         progress.start(&format!("fit {}", m.name), 1);
         let t0 = Instant::now();
-        p.fit(&train_tr)?;
+        p.fit_grouped(&train_tr, &groups)?;
         fit_seconds.push(t0.elapsed().as_secs_f64());
         progress.finish();
         predictors.push(p);
@@ -412,6 +426,40 @@ pub fn run(
         train,
         test,
     })
+}
+
+/// Cross-validation by group: the groups (users, vehicles) of `segments` are dealt into
+/// `folds` folds ([`harness::group_folds`], seeded by `seed`); each fold's segments are the
+/// test part once, with the other folds' segments training. The protocol's own split and
+/// `max_train` are not used (every other fold trains); `max_test` still bounds each test
+/// part. One [`ProtocolRun`] per fold, in fold order.
+pub fn cross_validate(
+    protocol: &Protocol,
+    segments: &[Segment],
+    folds: usize,
+    seed: u64,
+    progress: &dyn Progress,
+) -> Result<Vec<ProtocolRun>> {
+    protocol.validate()?;
+    let ids = harness::group_ids(segments);
+    let groups = ids.iter().copied().max().map_or(0, |m| m + 1);
+    let fold_of = harness::group_folds(groups, folds, seed)?;
+    (0..folds)
+        .map(|f| {
+            let (mut test, mut train) = (Vec::new(), Vec::new());
+            for (s, &g) in segments.iter().zip(&ids) {
+                if fold_of[g] == f {
+                    test.push(s.clone());
+                } else {
+                    train.push(s.clone());
+                }
+            }
+            if let Some(n) = protocol.max_test {
+                test.truncate(n);
+            }
+            run_split(protocol, segments.len(), train, test, progress)
+        })
+        .collect()
 }
 
 impl ProtocolRun {

@@ -1,5 +1,7 @@
 //! Every method of the four papers as a [`Predictor`](trajpred_core::Predictor).
 
+mod aligned_ridge;
+mod auto;
 mod cv_time;
 mod gskf;
 mod hmm;
@@ -8,6 +10,8 @@ mod kf_time;
 mod particle;
 mod poly;
 
+pub use aligned_ridge::{AlignedRidge, AlignedRidgeParams};
+pub use auto::{Auto, AutoParams, CandidateScore, DEFAULT_CANDIDATES};
 pub use cv_time::CvTime;
 pub use gskf::{Gsc, Gskf, GskfParams};
 pub use hmm::{Hmm, HmmParams};

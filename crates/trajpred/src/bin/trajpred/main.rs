@@ -3,6 +3,7 @@
 // a command-line tool writes its results to standard output
 #![allow(clippy::print_stdout)]
 
+mod folds;
 mod output;
 mod progress;
 
@@ -15,7 +16,7 @@ use trajpred::dataset::{self, Dataset, Loaded, Segment, Segmentation};
 use trajpred::harness::{MethodReport, Split};
 use trajpred::plot::{Chart, Series, write_chart};
 use trajpred::protocol::{self, MethodSpec, Protocol};
-use trajpred::registry::{MethodOptions, all_methods, build};
+use trajpred::registry::{MethodOptions, all_methods, build, leaderboard_methods};
 use trajpred_core::MAX_HORIZON;
 use trajpred_core::{Forecast, Trajectory};
 use trajpred_data::LoadOptions;
@@ -160,7 +161,8 @@ enum Command {
         /// File or folder to load (a dataset's root folder works).
         #[arg(long)]
         path: PathBuf,
-        /// Comma-separated methods.
+        /// Comma-separated methods; `all` is every method that runs in minutes without extra
+        /// files (all but the particle filters and the neural networks, see `docs/accuracy.md`).
         #[arg(long, default_value = "kf-dynamic,naive-kf,poly1,poly2,hmm")]
         methods: String,
         /// History length given to the predictors.
@@ -211,6 +213,14 @@ enum Command {
         /// No progress bars (they are off anyway when stderr is not a terminal).
         #[arg(long)]
         quiet: bool,
+        /// Cross-validate by user instead of one split: users are dealt into this many folds
+        /// (seeded by `--seed`), each fold is the test part once with the others training;
+        /// the table gives the mean and standard deviation over folds.
+        #[arg(long)]
+        folds: Option<usize>,
+        /// Also draw the per-step mean error of the best methods (SVG or PNG by extension).
+        #[arg(long)]
+        figure: Option<PathBuf>,
     },
     /// Draw a track and a method's forecast from an origin (SVG or PNG by extension).
     Plot {
@@ -266,6 +276,15 @@ fn load_one(input: &Input) -> Result<Segment> {
 fn say_skips(loaded: &Loaded) {
     if loaded.report.skipped_total() > 0 || loaded.counts.too_short > 0 {
         eprintln!("note: {}", loaded.summary());
+    }
+}
+
+/// Tells on stderr what each fitted method chose (`auto`'s pick and fold scores, ...).
+fn say_fitted(run: &protocol::ProtocolRun) {
+    for (label, p) in run.labels.iter().zip(&run.predictors) {
+        if let Some(s) = p.fitted_summary() {
+            eprintln!("{label}: {s}");
+        }
     }
 }
 
@@ -350,6 +369,8 @@ fn run(cli: Cli) -> Result<()> {
             quick,
             format,
             quiet,
+            folds,
+            figure,
         } => {
             let bars = Bars::new(quiet)?;
             check_horizon(horizon)?;
@@ -373,12 +394,24 @@ fn run(cli: Cli) -> Result<()> {
                         kf_q,
                         seed,
                         horizons: MethodOptions::default().horizons.max(horizon),
+                        // what `auto` and `aligned-ridge` score their held-out folds by
+                        eval: trajpred::harness::EvalConfig {
+                            history,
+                            horizon,
+                            stride,
+                            threshold,
+                            max_origins_per_trajectory: max_origins,
+                        },
                         ..Default::default()
                     };
                     let names: Vec<&str> = methods
                         .split(',')
                         .map(str::trim)
                         .filter(|s| !s.is_empty())
+                        .flat_map(|s| match s {
+                            "all" => leaderboard_methods(),
+                            _ => vec![s],
+                        })
                         .collect();
                     if names.is_empty() {
                         bail!("--methods names no method");
@@ -445,7 +478,37 @@ fn run(cli: Cli) -> Result<()> {
                     loaded.segments.len()
                 );
             }
+            if let Some(k) = folds {
+                if !matches!(p.split, Split::ByGroup { .. }) {
+                    bail!("--folds cross-validates by user: use it with --split by-user");
+                }
+                let seed = seed.unwrap_or(0);
+                let runs = protocol::cross_validate(&p, &loaded.segments, k, seed, &bars)?;
+                for (f, r) in runs.iter().enumerate() {
+                    eprintln!(
+                        "fold {f}: {} training and {} test segments",
+                        r.train.len(),
+                        r.test.len()
+                    );
+                    say_fitted(r);
+                }
+                let s = folds::summarise(&runs);
+                print!("{}", folds::markdown(&s, k));
+                if let Some(path) = &figure {
+                    let title = format!("{}: mean error per step, {k} folds by user", p.dataset);
+                    folds::figure(&s, &title, path)?;
+                    eprintln!("wrote {}", path.display());
+                }
+                return Ok(());
+            }
             let run = protocol::run(&p, &loaded.segments, &bars)?;
+            say_fitted(&run);
+            if let Some(path) = &figure {
+                let s = folds::summarise(std::slice::from_ref(&run));
+                let title = format!("{}: mean error per step ({})", p.dataset, p.split.label());
+                folds::figure(&s, &title, path)?;
+                eprintln!("wrote {}", path.display());
+            }
             eprintln!(
                 "{}: {} training and {} test segments ({} split)",
                 p.name,
