@@ -207,45 +207,63 @@ impl Auto {
     }
 
     fn score(&self, name: &str, train: &[Trajectory], groups: &[usize]) -> Result<CandidateScore> {
-        let (fold, k) = fold_of_trajectories(groups, self.params.folds, self.params.seed)?;
-        let mut s = CandidateScore {
-            method: name.to_string(),
-            fold_errors: Vec::with_capacity(k),
-            fold_forecasts: Vec::with_capacity(k),
-            pooled_error: f64::INFINITY,
-            failure: None,
-        };
-        let (mut sum, mut n) = (0.0, 0usize);
-        for f in 0..k {
-            let (fit, fit_groups, held) = fold_split(train, groups, &fold, f);
-            let mut p = registry::build(name, &self.options)?;
-            if let Err(e) = p.fit_grouped(&fit, &fit_groups) {
-                s.failure = Some(format!("fold {f}: fit: {e}"));
-                return Ok(s);
-            }
-            let r = harness::evaluate(p.as_ref(), &held, &self.params.eval, None)?;
-            if r.failures > 0 {
-                s.failure = Some(format!(
-                    "fold {f}: {} forecasts refused ({})",
-                    r.failures,
-                    r.first_failure.unwrap_or_default()
-                ));
-                return Ok(s);
-            }
-            s.fold_errors.push(r.mean_euclidean_all);
-            s.fold_forecasts.push(r.forecasts);
-            if r.forecasts > 0 {
-                sum += r.mean_euclidean_all * r.forecasts as f64;
-                n += r.forecasts;
-            }
-        }
-        if n == 0 {
-            s.failure = Some("no origin in any held-out fold".into());
-        } else {
-            s.pooled_error = sum / n as f64;
-        }
-        Ok(s)
+        let build = || registry::build(name, &self.options);
+        let (p, e) = (&self.params, &self.params.eval);
+        cross_validate(name, &build, train, groups, p.folds, p.seed, e)
     }
+}
+
+/// The cross-validated score of one method: `build` makes it unfitted; for each of `folds`
+/// folds of groups ([`harness::group_folds`] with `seed`) it is fitted on the other folds and
+/// evaluated on the held-out one by [`harness::evaluate`] with `eval`. What [`Auto`] ranks its
+/// candidates by, public so that a tuning script can score variants the same way.
+pub fn cross_validate(
+    name: &str,
+    build: &dyn Fn() -> Result<Box<dyn Predictor>>,
+    train: &[Trajectory],
+    groups: &[usize],
+    folds: usize,
+    seed: u64,
+    eval: &EvalConfig,
+) -> Result<CandidateScore> {
+    let (fold, k) = fold_of_trajectories(groups, folds, seed)?;
+    let mut s = CandidateScore {
+        method: name.to_string(),
+        fold_errors: Vec::with_capacity(k),
+        fold_forecasts: Vec::with_capacity(k),
+        pooled_error: f64::INFINITY,
+        failure: None,
+    };
+    let (mut sum, mut n) = (0.0, 0usize);
+    for f in 0..k {
+        let (fit, fit_groups, held) = fold_split(train, groups, &fold, f);
+        let mut p = build()?;
+        if let Err(e) = p.fit_grouped(&fit, &fit_groups) {
+            s.failure = Some(format!("fold {f}: fit: {e}"));
+            return Ok(s);
+        }
+        let r = harness::evaluate(p.as_ref(), &held, eval, None)?;
+        if r.failures > 0 {
+            s.failure = Some(format!(
+                "fold {f}: {} forecasts refused ({})",
+                r.failures,
+                r.first_failure.unwrap_or_default()
+            ));
+            return Ok(s);
+        }
+        s.fold_errors.push(r.mean_euclidean_all);
+        s.fold_forecasts.push(r.forecasts);
+        if r.forecasts > 0 {
+            sum += r.mean_euclidean_all * r.forecasts as f64;
+            n += r.forecasts;
+        }
+    }
+    if n == 0 {
+        s.failure = Some("no origin in any held-out fold".into());
+    } else {
+        s.pooled_error = sum / n as f64;
+    }
+    Ok(s)
 }
 
 impl Predictor for Auto {

@@ -11,7 +11,7 @@ mod particle;
 mod poly;
 
 pub use aligned_ridge::{AlignedRidge, AlignedRidgeParams};
-pub use auto::{Auto, AutoParams, CandidateScore, DEFAULT_CANDIDATES};
+pub use auto::{Auto, AutoParams, CandidateScore, DEFAULT_CANDIDATES, cross_validate};
 pub use cv_time::CvTime;
 pub use gskf::{Gsc, Gskf, GskfParams};
 pub use hmm::{Hmm, HmmParams};
