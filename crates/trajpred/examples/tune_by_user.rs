@@ -60,12 +60,24 @@ fn main() -> Result<()> {
     };
     let mut variants: Vec<(String, AlignedRidgeParams)> = Vec::new();
     for &lambda in &[1e-2, 1e-1, 1.0, 10.0] {
-        variants.push((format!("ridge k=4 lambda={lambda}"), ridge(4, lambda, 0, &[])));
-        variants.push((format!("robust k=4 lambda={lambda}"), ridge(4, lambda, 5, &[])));
+        variants.push((
+            format!("ridge k=4 lambda={lambda}"),
+            ridge(4, lambda, 0, &[]),
+        ));
+        variants.push((
+            format!("robust k=4 lambda={lambda}"),
+            ridge(4, lambda, 5, &[]),
+        ));
     }
     for &lambda in &[1e-2, 1e-1, 1.0] {
-        variants.push((format!("robust k=8 lambda={lambda}"), ridge(8, lambda, 5, &[])));
-        variants.push((format!("robust k=2 lambda={lambda}"), ridge(2, lambda, 5, &[])));
+        variants.push((
+            format!("robust k=8 lambda={lambda}"),
+            ridge(8, lambda, 5, &[]),
+        ));
+        variants.push((
+            format!("robust k=2 lambda={lambda}"),
+            ridge(2, lambda, 5, &[]),
+        ));
         variants.push((
             format!("robust k=4 bins 2,7 m/s lambda={lambda}"),
             ridge(4, lambda, 5, &[2.0, 7.0]),

@@ -372,8 +372,7 @@ fn run_split(
             name: "segments",
             reason: format!(
                 "{} segments of at least {} points: too few for a test part",
-                segments,
-                protocol.segmentation.min_points
+                segments, protocol.segmentation.min_points
             ),
         });
     }

@@ -178,7 +178,11 @@ fn auto_in_the_evaluation_path_never_reads_the_test_users() {
         .collect();
     let run = protocol::run(&p, &poisoned, &Silent).unwrap();
     let summary = |r: &protocol::ProtocolRun| r.predictors[0].fitted_summary().unwrap();
-    assert!(summary(&clean).starts_with("chose cv-time"), "{}", summary(&clean));
+    assert!(
+        summary(&clean).starts_with("chose cv-time"),
+        "{}",
+        summary(&clean)
+    );
     assert_eq!(summary(&run), summary(&clean));
     // the poison has power: fitted on every user, auto would choose another method
     let all: Vec<Trajectory> = poisoned.iter().map(|s| s.trajectory.clone()).collect();
@@ -204,14 +208,18 @@ fn folds_deal_every_user_into_exactly_one_test_part() {
         .flat_map(|u| (0..2).map(move |i| (u, i)))
         .map(|(u, i)| segment(&format!("u{u}"), i, straight(&mut rng)))
         .collect();
-    let runs = protocol::cross_validate(&custom_protocol(&["cv-time"]), &segments, 3, 5, &Silent)
-        .unwrap();
+    let runs =
+        protocol::cross_validate(&custom_protocol(&["cv-time"]), &segments, 3, 5, &Silent).unwrap();
     assert_eq!(runs.len(), 3);
     let mut tested: Vec<String> = Vec::new();
     for r in &runs {
         assert_eq!(r.train.len() + r.test.len(), segments.len());
         for s in &r.test {
-            assert!(r.train.iter().all(|t| t.group != s.group), "{} on both sides", s.group);
+            assert!(
+                r.train.iter().all(|t| t.group != s.group),
+                "{} on both sides",
+                s.group
+            );
             tested.push(s.id.clone());
         }
     }

@@ -73,7 +73,8 @@ impl AlignedRidgeParams {
                 format!("must be finite and non-negative, got {l}"),
             ));
         }
-        if self.lambda.is_none() && (self.lambda_grid.is_empty() || !self.lambda_grid.iter().all(ok))
+        if self.lambda.is_none()
+            && (self.lambda_grid.is_empty() || !self.lambda_grid.iter().all(ok))
         {
             return Err(invalid(
                 "lambda_grid",
@@ -139,7 +140,10 @@ impl Frame {
     fn new(t: &[f64], x: &[f64], y: &[f64], o: usize, lags: usize) -> Self {
         let vel = |j: usize| {
             let dt = t[o - j] - t[o - j - 1];
-            ((x[o - j] - x[o - j - 1]) / dt, (y[o - j] - y[o - j - 1]) / dt)
+            (
+                (x[o - j] - x[o - j - 1]) / dt,
+                (y[o - j] - y[o - j - 1]) / dt,
+            )
         };
         let vs: Vec<(f64, f64)> = (0..lags).map(vel).collect();
         let u = vs
@@ -267,14 +271,12 @@ fn solve(n: &Normal, lambda: f64) -> Result<Vec<DMatrix<f64>>> {
             let p = g.nrows();
             let m = (g.trace() / p as f64).max(f64::MIN_POSITIVE);
             let a = g + DMatrix::identity(p, p) * (lambda * m + 1e-9);
-            a.cholesky()
-                .map(|c| c.solve(e))
-                .ok_or_else(|| {
-                    invalid(
-                        "train",
-                        format!("model {s}: the normal matrix is singular (too few origins?)"),
-                    )
-                })
+            a.cholesky().map(|c| c.solve(e)).ok_or_else(|| {
+                invalid(
+                    "train",
+                    format!("model {s}: the normal matrix is singular (too few origins?)"),
+                )
+            })
         })
         .collect()
 }

@@ -93,7 +93,11 @@ pub fn markdown(s: &Summary, folds: usize) -> String {
 /// eight, best first), as a line chart.
 pub fn figure(s: &Summary, title: &str, path: &Path) -> Result<()> {
     let overall: Vec<f64> = s.errors.iter().map(|v| mean_sd(v).0).collect();
-    let best = overall.iter().copied().filter(|e| e.is_finite()).fold(f64::INFINITY, f64::min);
+    let best = overall
+        .iter()
+        .copied()
+        .filter(|e| e.is_finite())
+        .fold(f64::INFINITY, f64::min);
     let mut order: Vec<usize> = (0..s.labels.len())
         .filter(|&i| overall[i].is_finite() && overall[i] <= 1.5 * best)
         .collect();
