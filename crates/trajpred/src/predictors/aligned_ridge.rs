@@ -314,9 +314,9 @@ fn solve(n: &Normal, lambda: f64) -> Result<Vec<DMatrix<f64>>> {
 /// let mut m = AlignedRidge::new(AlignedRidgeParams { lambda: Some(1e-6), ..Default::default() })?;
 /// m.fit(&train)?;
 /// let hist = track(9)?.prefix(21)?; // origin at t = 20 s, speed there 6 m/s
-/// let f = m.forecast_times(&hist, &[25.0])?;
+/// let f = m.forecast_times(&hist, &[21.0, 22.0, 23.0, 24.0, 25.0])?;
 /// let truth = 10.0 * 25.0 - 0.1 * 625.0 + 9.0;
-/// assert!((f.step(1)[0] - truth).abs() < 0.01);
+/// assert!((f.step(5)[0] - truth).abs() < 0.01);
 /// # Ok::<(), trajpred_core::Error>(())
 /// ```
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -422,18 +422,11 @@ impl Predictor for AlignedRidge {
 
     /// Every trajectory its own group (see [`Predictor::fit_grouped`]).
     fn fit(&mut self, train: &[Trajectory]) -> Result<()> {
-        let groups: Vec<usize> = (0..train.len()).collect();
-        self.fit_grouped(train, &groups)
+        self.fit_grouped(train, &super::own_groups(train))
     }
 
     fn fit_grouped(&mut self, train: &[Trajectory], groups: &[usize]) -> Result<()> {
-        if groups.len() != train.len() {
-            return Err(Error::LengthMismatch {
-                what: "groups vs training trajectories",
-                expected: train.len(),
-                got: groups.len(),
-            });
-        }
+        super::check_groups(train, groups)?;
         if train.is_empty() {
             return Err(Error::Empty {
                 what: "training trajectories",

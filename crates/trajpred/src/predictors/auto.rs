@@ -273,18 +273,11 @@ impl Predictor for Auto {
 
     /// Every trajectory its own group (see [`Predictor::fit_grouped`]).
     fn fit(&mut self, train: &[Trajectory]) -> Result<()> {
-        let groups: Vec<usize> = (0..train.len()).collect();
-        self.fit_grouped(train, &groups)
+        self.fit_grouped(train, &super::own_groups(train))
     }
 
     fn fit_grouped(&mut self, train: &[Trajectory], groups: &[usize]) -> Result<()> {
-        if groups.len() != train.len() {
-            return Err(Error::LengthMismatch {
-                what: "groups vs training trajectories",
-                expected: train.len(),
-                got: groups.len(),
-            });
-        }
+        super::check_groups(train, groups)?;
         self.chosen = None;
         self.folds_used = fold_of_trajectories(groups, self.params.folds, self.params.seed)?.1;
         let scores = self

@@ -59,3 +59,21 @@ pub(crate) fn step_interval(history: &Trajectory, window: usize) -> f64 {
     let t = history.times();
     (t[n - 1] - t[n - w.min(n)]) / (w.min(n) - 1) as f64
 }
+
+/// Each trajectory its own group: what `fit` without groups means for the methods that
+/// cross-validate by group.
+pub(crate) fn own_groups(train: &[Trajectory]) -> Vec<usize> {
+    (0..train.len()).collect()
+}
+
+/// One group label per training trajectory.
+pub(crate) fn check_groups(train: &[Trajectory], groups: &[usize]) -> Result<()> {
+    if groups.len() == train.len() {
+        return Ok(());
+    }
+    Err(Error::LengthMismatch {
+        what: "groups vs training trajectories",
+        expected: train.len(),
+        got: groups.len(),
+    })
+}
