@@ -163,6 +163,23 @@ pub trait Predictor: Send + Sync {
     /// Learns whatever the method learns from training trajectories (may be a no-op).
     fn fit(&mut self, train: &[Trajectory]) -> Result<()>;
 
+    /// [`Predictor::fit`] told which group (user, vehicle, file) each training trajectory
+    /// came from: `groups[i]` labels `train[i]`, and trajectories with the same label belong
+    /// together. Methods that choose something by cross-validation use it to hold out whole
+    /// groups, so that a choice is scored on users the fold did not train on; the default
+    /// ignores the labels and calls [`Predictor::fit`]. The evaluation path calls this one,
+    /// with the segments' groups. Errors if the lengths differ.
+    fn fit_grouped(&mut self, train: &[Trajectory], groups: &[usize]) -> Result<()> {
+        if groups.len() != train.len() {
+            return Err(Error::LengthMismatch {
+                what: "groups vs training trajectories",
+                expected: train.len(),
+                got: groups.len(),
+            });
+        }
+        self.fit(train)
+    }
+
     /// Predicts `horizon` steps after the last point of `history`.
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast>;
 
@@ -245,6 +262,9 @@ impl<P: Predictor + ?Sized> Predictor for Box<P> {
     }
     fn fit(&mut self, train: &[Trajectory]) -> Result<()> {
         (**self).fit(train)
+    }
+    fn fit_grouped(&mut self, train: &[Trajectory], groups: &[usize]) -> Result<()> {
+        (**self).fit_grouped(train, groups)
     }
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
         (**self).forecast(history, horizon)

@@ -442,3 +442,37 @@ pub fn split_segments(segments: &[Segment], how: Split) -> Result<(Vec<Segment>,
         }
     }
 }
+
+/// The group of each segment as a dense id: the groups' names ([`Segment::group`]) sorted,
+/// numbered from 0. What [`Predictor::fit_grouped`] is given by the evaluation path.
+pub fn group_ids(segments: &[Segment]) -> Vec<usize> {
+    let mut names: Vec<&str> = segments.iter().map(|s| s.group.as_str()).collect();
+    names.sort_unstable();
+    names.dedup();
+    segments
+        .iter()
+        .map(|s| names.binary_search(&s.group.as_str()).unwrap_or(0))
+        .collect()
+}
+
+/// Deals `groups` distinct group labels into `folds` folds for cross-validation by group: the
+/// labels are sorted, shuffled with `seed` and dealt round-robin, so fold sizes (in groups)
+/// differ by at most one. Returns, for each label in sorted order, its fold. Needs
+/// `2 <= folds <= groups`.
+pub fn group_folds(groups: usize, folds: usize, seed: u64) -> Result<Vec<usize>> {
+    use rand::SeedableRng;
+    use rand::seq::SliceRandom;
+    if folds < 2 || folds > groups {
+        return Err(Error::InvalidParameter {
+            name: "folds",
+            reason: format!("must be between 2 and the number of groups ({groups}), got {folds}"),
+        });
+    }
+    let mut order: Vec<usize> = (0..groups).collect();
+    order.shuffle(&mut rand_chacha::ChaCha8Rng::seed_from_u64(seed));
+    let mut fold = vec![0; groups];
+    for (i, &g) in order.iter().enumerate() {
+        fold[g] = i % folds;
+    }
+    Ok(fold)
+}

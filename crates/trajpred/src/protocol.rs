@@ -393,8 +393,22 @@ pub fn split(protocol: &Protocol, segments: &[Segment]) -> Result<(Vec<Segment>,
     Ok((train, test))
 }
 
-/// Makes the predictor of a method for [`run_with`], given the training trajectories.
-pub type Fitter<'a> = dyn Fn(&MethodSpec, &[Trajectory]) -> Result<Box<dyn Predictor>> + 'a;
+/// Makes the predictor of a method for [`run_with`], given the training trajectories and
+/// their groups (users, vehicles; one label per trajectory).
+pub type Fitter<'a> =
+    dyn Fn(&MethodSpec, &[Trajectory], &[usize]) -> Result<Box<dyn Predictor>> + 'a;
+
+/// Builds the method and fits it, telling it the training segments' groups
+/// ([`Predictor::fit_grouped`]): what [`run`] and [`cross_validate`] do.
+fn build_and_fit(
+    m: &MethodSpec,
+    train: &[Trajectory],
+    groups: &[usize],
+) -> Result<Box<dyn Predictor>> {
+    let mut p = build(&m.name, &m.options)?;
+    p.fit_grouped(train, groups)?;
+    Ok(p)
+}
 
 /// Splits, fits and evaluates `segments` as `protocol` says.
 pub fn run(
@@ -402,11 +416,7 @@ pub fn run(
     segments: &[Segment],
     progress: &dyn Progress,
 ) -> Result<ProtocolRun> {
-    run_with(protocol, segments, progress, &|m, train| {
-        let mut p = build(&m.name, &m.options)?;
-        p.fit(train)?;
-        Ok(p)
-    })
+    run_with(protocol, segments, progress, &build_and_fit)
 }
 
 /// [`run`] with the predictors made by `fitter` (e.g. loaded from saved parameters instead
@@ -419,23 +429,37 @@ pub fn run_with(
 ) -> Result<ProtocolRun> {
     protocol.validate()?;
     let (train, test) = split(protocol, segments)?;
+    run_split(protocol, segments.len(), train, test, progress, fitter)
+}
+
+/// [`run_with`] on a split already made: makes each method's predictor with `fitter` from
+/// `train` and its groups and evaluates on `test`. `segments` (how many there were before
+/// the split) only words the error for an empty test part.
+fn run_split(
+    protocol: &Protocol,
+    segments: usize,
+    train: Vec<Segment>,
+    test: Vec<Segment>,
+    progress: &dyn Progress,
+    fitter: &Fitter<'_>,
+) -> Result<ProtocolRun> {
     if test.is_empty() {
         return Err(Error::InvalidParameter {
             name: "segments",
             reason: format!(
                 "{} segments of at least {} points: too few for a test part",
-                segments.len(),
-                protocol.segmentation.min_points
+                segments, protocol.segmentation.min_points
             ),
         });
     }
     let train_tr: Vec<Trajectory> = train.iter().map(|s| s.trajectory.clone()).collect();
+    let groups = harness::group_ids(&train);
     let mut predictors = Vec::with_capacity(protocol.methods.len());
     let mut fit_seconds = Vec::with_capacity(protocol.methods.len());
     for m in &protocol.methods {
         progress.start(&format!("fit {}", m.name), 1);
         let t0 = Instant::now();
-        let p = fitter(m, &train_tr)?;
+        let p = fitter(m, &train_tr, &groups)?;
         fit_seconds.push(t0.elapsed().as_secs_f64());
         progress.finish();
         predictors.push(p);
@@ -476,6 +500,47 @@ pub fn run_with(
         train,
         test,
     })
+}
+
+/// Cross-validation by group: the groups (users, vehicles) of `segments` are dealt into
+/// `folds` folds ([`harness::group_folds`], seeded by `seed`); each fold's segments are the
+/// test part once, with the other folds' segments training. The protocol's own split and
+/// `max_train` are not used (every other fold trains); `max_test` still bounds each test
+/// part. One [`ProtocolRun`] per fold, in fold order.
+pub fn cross_validate(
+    protocol: &Protocol,
+    segments: &[Segment],
+    folds: usize,
+    seed: u64,
+    progress: &dyn Progress,
+) -> Result<Vec<ProtocolRun>> {
+    protocol.validate()?;
+    let ids = harness::group_ids(segments);
+    let groups = ids.iter().copied().max().map_or(0, |m| m + 1);
+    let fold_of = harness::group_folds(groups, folds, seed)?;
+    (0..folds)
+        .map(|f| {
+            let (mut test, mut train) = (Vec::new(), Vec::new());
+            for (s, &g) in segments.iter().zip(&ids) {
+                if fold_of[g] == f {
+                    test.push(s.clone());
+                } else {
+                    train.push(s.clone());
+                }
+            }
+            if let Some(n) = protocol.max_test {
+                test.truncate(n);
+            }
+            run_split(
+                protocol,
+                segments.len(),
+                train,
+                test,
+                progress,
+                &build_and_fit,
+            )
+        })
+        .collect()
 }
 
 impl ProtocolRun {

@@ -20,6 +20,10 @@ pub struct MethodOptions {
     pub horizons: usize,
     /// Training epochs of the neural networks; `None` keeps each preset's (the papers').
     pub epochs: Option<usize>,
+    /// The evaluation the methods that choose by cross-validation (`auto`, `aligned-ridge`)
+    /// score their held-out folds by: the run's history, horizon, stride and origins.
+    #[serde(default)]
+    pub eval: crate::harness::EvalConfig,
 }
 
 impl Default for MethodOptions {
@@ -31,6 +35,7 @@ impl Default for MethodOptions {
             window: 6,
             horizons: 6,
             epochs: None,
+            eval: crate::harness::EvalConfig::default(),
         }
     }
 }
@@ -115,6 +120,14 @@ pub const METHODS: &[MethodInfo] = &[
         name: "hmm",
         description: "k-means motion states + HMM forward filter (K chosen on training data)",
     },
+    MethodInfo {
+        name: "aligned-ridge",
+        description: "last velocity corrected by a ridge regression in the heading-aligned frame, strength chosen by CV by user",
+    },
+    MethodInfo {
+        name: "auto",
+        description: "the candidate with the lowest cross-validated error by user on the training part (see predictors::Auto)",
+    },
 ];
 
 /// The neural methods (with the `neural` feature, on by default).
@@ -148,6 +161,21 @@ pub fn all_methods() -> Vec<MethodInfo> {
     #[cfg(feature = "neural")]
     v.extend_from_slice(NEURAL_METHODS);
     v
+}
+
+/// Methods `--methods all` leaves out: the particle filters, for their run time (minutes on
+/// a leaderboard's hundred thousand forecasts, and far behind on real data: see
+/// `docs/accuracy.md`). The neural networks ([`all_methods`] beyond [`METHODS`]) are left
+/// out too: hundreds of training epochs each.
+pub const SLOW_METHODS: &[&str] = &["pf", "mkpf"];
+
+/// What `--methods all` runs: [`METHODS`] without [`SLOW_METHODS`], in registry order.
+pub fn leaderboard_methods() -> Vec<&'static str> {
+    METHODS
+        .iter()
+        .map(|m| m.name)
+        .filter(|n| !SLOW_METHODS.contains(n))
+        .collect()
 }
 
 #[cfg(feature = "neural")]
@@ -233,6 +261,20 @@ pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
             seed: opts.seed,
             ..Default::default()
         })?),
+        "aligned-ridge" => Box::new(AlignedRidge::new(AlignedRidgeParams {
+            horizons: opts.horizons,
+            seed: opts.seed,
+            eval: opts.eval,
+            ..Default::default()
+        })?),
+        "auto" => Box::new(Auto::new(
+            AutoParams {
+                seed: opts.seed,
+                eval: opts.eval,
+                ..Default::default()
+            },
+            opts.clone(),
+        )?),
         _ => {
             return Err(Error::InvalidParameter {
                 name: "method",

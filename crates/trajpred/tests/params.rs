@@ -202,7 +202,7 @@ fn evaluating_loaded_parameters_gives_the_table_of_evaluating_with_fitting() {
     let segs = segments();
     let fitted = protocol::run(&p, &segs, &Silent).expect("run");
     let file = reload(&fitted_file(&methods));
-    let loaded = protocol::run_with(&p, &segs, &Silent, &|m, _| {
+    let loaded = protocol::run_with(&p, &segs, &Silent, &|m, _, _| {
         file.predictor(&m.label)
             .map_err(|e| Error::method(m.label.clone(), e))
     })

@@ -1,5 +1,7 @@
 //! Every method of the four papers as a [`Predictor`](trajpred_core::Predictor).
 
+mod aligned_ridge;
+mod auto;
 mod cv_time;
 mod fitted;
 mod gskf;
@@ -10,6 +12,8 @@ mod kf_time;
 mod particle;
 mod poly;
 
+pub use aligned_ridge::{AlignedRidge, AlignedRidgeParams};
+pub use auto::{Auto, AutoParams, CandidateScore, DEFAULT_CANDIDATES, cross_validate};
 pub use cv_time::CvTime;
 pub use gskf::{Gsc, Gskf, GskfParams};
 pub use hmm::{Hmm, HmmParams, MAX_HMM_STATES};
@@ -81,4 +85,22 @@ pub(crate) fn offsets_after(history: &Trajectory, times: &[f64]) -> Result<Vec<f
     trajpred_core::check_forecast_args(history, times.len(), 1)?;
     let last = history.times()[history.len() - 1];
     Ok(times.iter().map(|&t| t - last).collect())
+}
+
+/// Each trajectory its own group: what `fit` without groups means for the methods that
+/// cross-validate by group.
+pub(crate) fn own_groups(train: &[Trajectory]) -> Vec<usize> {
+    (0..train.len()).collect()
+}
+
+/// One group label per training trajectory.
+pub(crate) fn check_groups(train: &[Trajectory], groups: &[usize]) -> Result<()> {
+    if groups.len() == train.len() {
+        return Ok(());
+    }
+    Err(Error::LengthMismatch {
+        what: "groups vs training trajectories",
+        expected: train.len(),
+        got: groups.len(),
+    })
 }

@@ -3,6 +3,7 @@
 // a command-line tool writes its results to standard output
 #![allow(clippy::print_stdout)]
 
+mod folds;
 mod output;
 mod progress;
 
@@ -12,11 +13,11 @@ use output::{Format, table, write_atomic, write_forecast};
 use progress::Bars;
 use std::path::PathBuf;
 use trajpred::dataset::{self, Dataset, Loaded, Segment, Segmentation};
-use trajpred::harness::{MethodReport, Split};
+use trajpred::harness::{EvalConfig, MethodReport, Split};
 use trajpred::params::{self, ParamsFile};
 use trajpred::plot::{Chart, Series, write_chart};
 use trajpred::protocol::{self, Protocol};
-use trajpred::registry::{MethodOptions, all_methods, build};
+use trajpred::registry::{MethodOptions, all_methods, build, leaderboard_methods};
 use trajpred_core::MAX_HORIZON;
 use trajpred_core::{Forecast, Trajectory};
 use trajpred_data::LoadOptions;
@@ -165,7 +166,8 @@ enum Command {
         /// File or folder to load (a dataset's root folder works).
         #[arg(long)]
         path: PathBuf,
-        /// Comma-separated methods.
+        /// Comma-separated methods; `all` is every method that runs in minutes without extra
+        /// files (all but the particle filters and the neural networks, see `docs/accuracy.md`).
         #[arg(long, default_value = "kf-dynamic,naive-kf,poly1,poly2,hmm")]
         methods: String,
         /// History length given to the predictors.
@@ -220,6 +222,14 @@ enum Command {
         /// (every method asked for must be in the file).
         #[arg(long)]
         params: Option<PathBuf>,
+        /// Cross-validate by user instead of one split: users are dealt into this many folds
+        /// (seeded by `--seed`), each fold is the test part once with the others training;
+        /// the table gives the mean and standard deviation over folds.
+        #[arg(long)]
+        folds: Option<usize>,
+        /// Also draw the per-step mean error of the best methods (SVG or PNG by extension).
+        #[arg(long)]
+        figure: Option<PathBuf>,
     },
     /// Fit methods on the training part of a dataset's split (the part `evaluate` with the
     /// same options fits on) and save what they learned to a JSON file.
@@ -322,6 +332,15 @@ fn say_skips(loaded: &Loaded) {
     }
 }
 
+/// Tells on stderr what each fitted method chose (`auto`'s pick and fold scores, ...).
+fn say_fitted(run: &protocol::ProtocolRun) {
+    for (label, p) in run.labels.iter().zip(&run.predictors) {
+        if let Some(s) = p.fitted_summary() {
+            eprintln!("{label}: {s}");
+        }
+    }
+}
+
 fn method_options(horizon: usize) -> MethodOptions {
     let d = MethodOptions::default();
     // the multi-step models are fitted for the longest forecast they will be asked
@@ -363,11 +382,13 @@ impl SplitArg {
 }
 
 /// The options of the methods `evaluate` and `fit` build from the command line.
-fn custom_options(kf_q: f64, seed: u64, horizon: usize) -> MethodOptions {
+fn custom_options(kf_q: f64, seed: u64, eval: EvalConfig) -> MethodOptions {
     MethodOptions {
         kf_q,
         seed,
-        horizons: MethodOptions::default().horizons.max(horizon),
+        horizons: MethodOptions::default().horizons.max(eval.horizon),
+        // what `auto` and `aligned-ridge` score their held-out folds by
+        eval,
         ..Default::default()
     }
 }
@@ -480,6 +501,8 @@ fn run(cli: Cli) -> Result<()> {
             format,
             quiet,
             params,
+            folds,
+            figure,
         } => {
             let bars = Bars::new(quiet)?;
             check_horizon(horizon)?;
@@ -499,11 +522,25 @@ fn run(cli: Cli) -> Result<()> {
                         .context("--dataset is needed (or --protocol)")?
                         .parse()?;
                     let seed = seed.unwrap_or(0);
-                    let opts = custom_options(kf_q, seed, horizon);
+                    let opts = custom_options(
+                        kf_q,
+                        seed,
+                        EvalConfig {
+                            history,
+                            horizon,
+                            stride,
+                            threshold,
+                            max_origins_per_trajectory: max_origins,
+                        },
+                    );
                     let names: Vec<&str> = methods
                         .split(',')
                         .map(str::trim)
                         .filter(|s| !s.is_empty())
+                        .flat_map(|s| match s {
+                            "all" => leaderboard_methods(),
+                            _ => vec![s],
+                        })
                         .collect();
                     if names.is_empty() {
                         bail!("--methods names no method");
@@ -546,13 +583,46 @@ fn run(cli: Cli) -> Result<()> {
                 }
             }
             let loaded = load_segments(&p, &path, &bars)?;
+            if let Some(k) = folds {
+                if saved.is_some() {
+                    bail!("--folds fits every fold anew: it cannot use --params");
+                }
+                if !matches!(p.split, Split::ByGroup { .. }) {
+                    bail!("--folds cross-validates by user: use it with --split by-user");
+                }
+                let seed = seed.unwrap_or(0);
+                let runs = protocol::cross_validate(&p, &loaded.segments, k, seed, &bars)?;
+                for (f, r) in runs.iter().enumerate() {
+                    eprintln!(
+                        "fold {f}: {} training and {} test segments",
+                        r.train.len(),
+                        r.test.len()
+                    );
+                    say_fitted(r);
+                }
+                let s = folds::summarise(&runs);
+                print!("{}", folds::markdown(&s, k));
+                if let Some(path) = &figure {
+                    let title = format!("{}: mean error per step, {k} folds by user", p.dataset);
+                    folds::figure(&s, &title, path)?;
+                    eprintln!("wrote {}", path.display());
+                }
+                return Ok(());
+            }
             let run = match &saved {
-                Some(file) => protocol::run_with(&p, &loaded.segments, &bars, &|m, _| {
+                Some(file) => protocol::run_with(&p, &loaded.segments, &bars, &|m, _, _| {
                     file.predictor(&m.label)
                         .map_err(|e| trajpred_core::Error::method(m.label.clone(), e))
                 })?,
                 None => protocol::run(&p, &loaded.segments, &bars)?,
             };
+            say_fitted(&run);
+            if let Some(path) = &figure {
+                let s = folds::summarise(std::slice::from_ref(&run));
+                let title = format!("{}: mean error per step ({})", p.dataset, p.split.label());
+                folds::figure(&s, &title, path)?;
+                eprintln!("wrote {}", path.display());
+            }
             eprintln!(
                 "{}: {} training and {} test segments ({} split)",
                 p.name,
@@ -641,7 +711,15 @@ fn run(cli: Cli) -> Result<()> {
             if names.iter().any(|n| n.is_empty()) {
                 bail!("--methods has an empty name: `{methods}`");
             }
-            let opts = custom_options(kf_q, seed, horizon);
+            let opts = custom_options(
+                kf_q,
+                seed,
+                EvalConfig {
+                    history,
+                    horizon,
+                    ..Default::default()
+                },
+            );
             let split = split.of(train_fraction, seed);
             let mut p = custom_protocol(
                 ds, &names, &opts, &segment, history, horizon, max_units, split,

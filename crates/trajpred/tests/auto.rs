@@ -1,0 +1,230 @@
+//! `auto` (choice by cross-validation by group on the training part) and the folds it and
+//! `evaluate --folds` deal users into.
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use trajpred::dataset::{Dataset, Segment, Segmentation};
+use trajpred::harness::{EvalConfig, Split, group_folds, group_ids};
+use trajpred::predictors::{Auto, AutoParams};
+use trajpred::protocol::{self, MethodSpec, Protocol, Silent};
+use trajpred::registry::MethodOptions;
+use trajpred_core::{Predictor, Trajectory};
+
+const EVAL: EvalConfig = EvalConfig {
+    history: 10,
+    horizon: 3,
+    stride: 1,
+    threshold: 25.0,
+    max_origins_per_trajectory: None,
+};
+
+/// A straight track at a random constant velocity, with irregular 1-3 s intervals: the last
+/// velocity over the actual times (`cv-time`) is exact.
+fn straight(rng: &mut ChaCha8Rng) -> Trajectory {
+    let (vx, vy) = (rng.random_range(-5.0..5.0), rng.random_range(-5.0..5.0));
+    let mut t = 0.0;
+    let (mut times, mut x, mut y) = (Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..40 {
+        times.push(t);
+        x.push(vx * t);
+        y.push(vy * t);
+        t += rng.random_range(1.0..3.0);
+    }
+    Trajectory::from_axes(times, vec![x, y]).unwrap()
+}
+
+/// A standing user whose fixes jump by up to 30 m: the last velocity is pure noise there, and
+/// methods that stay near the last fix win by far.
+fn jittery(rng: &mut ChaCha8Rng) -> Trajectory {
+    let x = (0..40).map(|_| rng.random_range(-30.0..30.0)).collect();
+    let y = (0..40).map(|_| rng.random_range(-30.0..30.0)).collect();
+    Trajectory::uniform(0.0, 1.0, vec![x, y]).unwrap()
+}
+
+fn segment(group: &str, i: usize, trajectory: Trajectory) -> Segment {
+    Segment {
+        group: group.to_string(),
+        id: format!("{group}-{i}"),
+        frame: trajpred_data::Frame::Cartesian,
+        trajectory,
+    }
+}
+
+fn options() -> MethodOptions {
+    MethodOptions {
+        eval: EVAL,
+        ..Default::default()
+    }
+}
+
+fn auto_over(candidates: &[&str]) -> Auto {
+    let params = AutoParams {
+        candidates: candidates.iter().map(|s| s.to_string()).collect(),
+        eval: EVAL,
+        ..Default::default()
+    };
+    Auto::new(params, options()).unwrap()
+}
+
+const CANDIDATES: &[&str] = &["kf-dynamic-literal", "cv-time", "poly2"];
+
+#[test]
+fn auto_picks_the_clearly_best_candidate_and_reports_the_folds() {
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let train: Vec<Trajectory> = (0..12).map(|_| straight(&mut rng)).collect();
+    let groups: Vec<usize> = (0..12).map(|i| i / 2).collect();
+    let mut auto = auto_over(CANDIDATES);
+    auto.fit_grouped(&train, &groups).unwrap();
+    assert_eq!(auto.chosen(), Some("cv-time"));
+    let scores = auto.scores();
+    assert_eq!(scores.len(), 3);
+    for s in scores {
+        assert_eq!(s.fold_errors.len(), 5, "{}", s.method);
+        assert!(s.failure.is_none(), "{}: {:?}", s.method, s.failure);
+    }
+    assert!(scores[1].pooled_error < 1e-6);
+    assert!(scores[0].pooled_error > 1.0 && scores[2].pooled_error > 1e-6);
+    let summary = auto.fitted_summary().unwrap();
+    assert!(summary.starts_with("chose cv-time by 5-fold"), "{summary}");
+    // the chosen method answers: exact on a new straight track
+    let test = straight(&mut rng);
+    let f = auto
+        .forecast_times(&test.prefix(20).unwrap(), &test.times()[20..23])
+        .unwrap();
+    for (k, p) in f.points().enumerate() {
+        let truth = test.point(20 + k);
+        assert!((p[0] - truth[0]).abs() < 1e-6 && (p[1] - truth[1]).abs() < 1e-6);
+    }
+    // the same seed and data give the same choice and scores
+    let mut again = auto_over(CANDIDATES);
+    again.fit_grouped(&train, &groups).unwrap();
+    assert_eq!(again.scores(), auto.scores());
+}
+
+#[test]
+fn auto_refuses_bad_settings_and_forecasts_only_once_fitted() {
+    let tr = Trajectory::uniform(0.0, 1.0, vec![vec![0.0, 1.0, 2.0]]).unwrap();
+    assert!(auto_over(CANDIDATES).forecast(&tr, 1).is_err());
+    for bad in [vec![], vec!["auto".to_string()], vec!["nope".to_string()]] {
+        let p = AutoParams {
+            candidates: bad,
+            ..Default::default()
+        };
+        assert!(Auto::new(p, options()).is_err());
+    }
+    let p = AutoParams {
+        folds: 1,
+        ..Default::default()
+    };
+    assert!(Auto::new(p, options()).is_err());
+    // one group cannot be cross-validated by group
+    let mut a = auto_over(CANDIDATES);
+    assert!(a.fit_grouped(&[tr.clone(), tr.clone()], &[3, 3]).is_err());
+    assert!(a.fit_grouped(&[tr], &[0, 1]).is_err());
+}
+
+fn custom_protocol(methods: &[&str]) -> Protocol {
+    Protocol {
+        name: "test".into(),
+        description: String::new(),
+        dataset: Dataset::Csv,
+        load_options: Dataset::Csv.options(),
+        max_units: None,
+        segmentation: Segmentation {
+            min_points: 13,
+            ..Default::default()
+        },
+        split: Split::ByGroup {
+            train_fraction: 0.3,
+            seed: 4,
+        },
+        max_train: None,
+        max_test: None,
+        histories: vec![EVAL.history],
+        horizon: EVAL.horizon,
+        stride: 1,
+        max_origins: None,
+        threshold: 25.0,
+        same_origins: false,
+        methods: methods
+            .iter()
+            .map(|m| MethodSpec {
+                label: m.to_string(),
+                name: m.to_string(),
+                options: options(),
+            })
+            .collect(),
+    }
+}
+
+#[test]
+fn auto_in_the_evaluation_path_never_reads_the_test_users() {
+    let mut rng = ChaCha8Rng::seed_from_u64(2);
+    let segments: Vec<Segment> = (0..10)
+        .flat_map(|u| (0..3).map(move |i| (u, i)))
+        .map(|(u, i)| segment(&format!("user{u}"), i, straight(&mut rng)))
+        .collect();
+    let p = custom_protocol(&["auto"]);
+    let clean = protocol::run(&p, &segments, &Silent).unwrap();
+    let test_users: Vec<String> = clean.test.iter().map(|s| s.group.clone()).collect();
+    assert!(test_users.len() >= 12, "most users test (30 % train)");
+    // poison the test users: standing, jumping fixes, where the last velocity is the worst
+    let poisoned: Vec<Segment> = segments
+        .iter()
+        .map(|s| match test_users.contains(&s.group) {
+            true => segment(&s.group, 0, jittery(&mut rng)),
+            false => s.clone(),
+        })
+        .collect();
+    let run = protocol::run(&p, &poisoned, &Silent).unwrap();
+    let summary = |r: &protocol::ProtocolRun| r.predictors[0].fitted_summary().unwrap();
+    assert!(
+        summary(&clean).starts_with("chose cv-time"),
+        "{}",
+        summary(&clean)
+    );
+    assert_eq!(summary(&run), summary(&clean));
+    // the poison has power: fitted on every user, auto would choose another method
+    let all: Vec<Trajectory> = poisoned.iter().map(|s| s.trajectory.clone()).collect();
+    let mut peeking = trajpred::registry::build("auto", &options()).unwrap();
+    peeking.fit_grouped(&all, &group_ids(&poisoned)).unwrap();
+    let s = peeking.fitted_summary().unwrap();
+    assert!(!s.starts_with("chose cv-time"), "{s}");
+}
+
+#[test]
+fn folds_deal_every_user_into_exactly_one_test_part() {
+    let fold = group_folds(7, 3, 9).unwrap();
+    assert_eq!(fold, group_folds(7, 3, 9).unwrap());
+    let sizes: Vec<usize> = (0..3)
+        .map(|f| fold.iter().filter(|&&g| g == f).count())
+        .collect();
+    assert_eq!(sizes.iter().sum::<usize>(), 7);
+    assert!(sizes.iter().all(|&n| n == 2 || n == 3), "{sizes:?}");
+    assert!(group_folds(7, 1, 0).is_err() && group_folds(2, 3, 0).is_err());
+
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let segments: Vec<Segment> = (0..6)
+        .flat_map(|u| (0..2).map(move |i| (u, i)))
+        .map(|(u, i)| segment(&format!("u{u}"), i, straight(&mut rng)))
+        .collect();
+    let runs =
+        protocol::cross_validate(&custom_protocol(&["cv-time"]), &segments, 3, 5, &Silent).unwrap();
+    assert_eq!(runs.len(), 3);
+    let mut tested: Vec<String> = Vec::new();
+    for r in &runs {
+        assert_eq!(r.train.len() + r.test.len(), segments.len());
+        for s in &r.test {
+            assert!(
+                r.train.iter().all(|t| t.group != s.group),
+                "{} on both sides",
+                s.group
+            );
+            tested.push(s.id.clone());
+        }
+    }
+    tested.sort();
+    let mut all: Vec<String> = segments.iter().map(|s| s.id.clone()).collect();
+    all.sort();
+    assert_eq!(tested, all);
+}
