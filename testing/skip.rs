@@ -4,12 +4,15 @@
 //! run that silently tested less is visible. Included by path (`#[path]`) by each such test,
 //! so there is one implementation.
 
+#![allow(dead_code)]
+
 use std::io::Write as _;
+use std::path::{Path, PathBuf};
 
 /// Reports that `test` skipped (part of) its work because of `reason`.
 pub fn skipped(test: &str, reason: &str) {
     eprintln!("SKIPPED {test}: {reason}");
-    let log = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("skipped-tests.log");
+    let log = Path::new(env!("CARGO_TARGET_TMPDIR")).join("skipped-tests.log");
     let line = format!("{test}: {reason}\n");
     let appended = std::fs::OpenOptions::new()
         .create(true)
@@ -19,4 +22,19 @@ pub fn skipped(test: &str, reason: &str) {
     if let Err(e) = appended {
         eprintln!("(could not record the skip in {}: {e})", log.display());
     }
+}
+
+/// The shared data folder (`../shared/data` beside the repository) when it holds the folder
+/// `needs`, or `None` after reporting that `test` skips its real-data parts.
+pub fn shared_data(test: &str, needs: &str) -> Option<PathBuf> {
+    let d = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
+    if d.join(needs).is_dir() {
+        return Some(d);
+    }
+    let reason = format!(
+        "the real-data parts need {} (see docs/data.md)",
+        d.join(needs).display()
+    );
+    skipped(test, &reason);
+    None
 }

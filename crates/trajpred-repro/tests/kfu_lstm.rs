@@ -22,18 +22,7 @@ struct Run {
 mod skip;
 
 fn data_dir() -> Option<PathBuf> {
-    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
-    let found = d.join("adsb-traffic").is_dir();
-    if !found {
-        skip::skipped(
-            "trajpred-repro/tests/kfu_lstm.rs",
-            &format!(
-                "the real-data parts need ADS-B flights at {} (see docs/data.md)",
-                d.join("adsb-traffic").display()
-            ),
-        );
-    }
-    found.then_some(d)
+    skip::shared_data("trajpred-repro/tests/kfu_lstm.rs", "adsb-traffic")
 }
 
 fn quick_run(data_dir: Option<PathBuf>) -> Run {

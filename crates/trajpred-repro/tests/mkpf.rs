@@ -13,18 +13,7 @@ use trajpred_repro::{Context, Paper, Value, reproduce_into, run_paper};
 mod skip;
 
 fn data_dir() -> Option<PathBuf> {
-    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
-    let found = d.join("adsb-traffic").is_dir();
-    if !found {
-        skip::skipped(
-            "trajpred-repro/tests/mkpf.rs",
-            &format!(
-                "the real-data parts need ADS-B flights at {} (see docs/data.md)",
-                d.join("adsb-traffic").display()
-            ),
-        );
-    }
-    found.then_some(d)
+    skip::shared_data("trajpred-repro/tests/mkpf.rs", "adsb-traffic")
 }
 
 fn quick(data_dir: Option<PathBuf>) -> Context {
