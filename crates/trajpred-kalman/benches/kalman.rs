@@ -9,7 +9,7 @@
 //!   range-bearing observation (filterpy's figure for the same step comes from
 //!   `benches/filterpy_ukf_step.py`).
 //!
-//! The inputs are in `benches/common/mod.rs`, shared with `examples/step_loop.rs`.
+//! The inputs are in `benches/common/mod.rs`, shared with `examples/profile_step_loop.rs`.
 
 mod common;
 

@@ -1,12 +1,12 @@
 #!/bin/bash
-# Paired timing of two `examples/step_loop` runs on a 2-core machine whose speed drifts:
+# Paired timing of two `examples/profile_step_loop` runs on a 2-core machine whose speed drifts:
 # run A on core 0 and B on core 1 at once, then swapped, and report per pair the geometric
 # mean of the two ratios B/A (which cancels the two cores' different speeds), sorted, with
 # the mean ns per step of each side and the median ratio.
 #
 # usage: paired.sh PAIRS BIN_A LOOP_A BIN_B LOOP_B [STEPS]
-#   e.g. cargo build --release -p trajpred-kalman --example step_loop
-#        B=target/release/examples/step_loop
+#   e.g. cargo build --release -p trajpred-kalman --example profile_step_loop
+#        B=target/release/examples/profile_step_loop
 #        bash crates/trajpred-kalman/benches/paired.sh 20 $B ads $B kf
 set -euo pipefail
 pairs=$1; bin_a=$2; loop_a=$3; bin_b=$4; loop_b=$5; steps=${6:-500000}

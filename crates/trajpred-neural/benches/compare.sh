@@ -14,8 +14,8 @@ here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../../.." && pwd)
 py=${PYTHON:-python3}
 export RAYON_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1
-cargo build --release -q -p trajpred-neural --example speed --manifest-path "$root/Cargo.toml"
-bin=${CARGO_TARGET_DIR:-$root/target}/release/examples/speed
+cargo build --release -q -p trajpred-neural --example profile_speed --manifest-path "$root/Cargo.toml"
+bin=${CARGO_TARGET_DIR:-$root/target}/release/examples/profile_speed
 out=$(mktemp)
 for i in $(seq "$runs"); do
     echo "# round $i: $(uptime)"

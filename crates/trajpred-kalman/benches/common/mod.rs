@@ -1,5 +1,5 @@
 //! The inputs shared by the criterion benchmarks (`benches/kalman.rs`) and the timing loop
-//! (`examples/step_loop.rs`, which includes this file): the KF problems with their adskalman
+//! (`examples/profile_step_loop.rs`, which includes this file): the KF problems with their adskalman
 //! twins, and the UKF problem.
 #![allow(non_snake_case)]
 

@@ -11,7 +11,7 @@
 //! Drops `warmup` epochs, times `repeat` more (each epoch's wall time as the training loop
 //! reports it) and prints one JSON line: median, quartiles, min and max in seconds.
 //!
-//! `cargo run --release -p trajpred-neural --example speed -- lstm|kfu [fused|composed] [warmup] [repeat]`
+//! `cargo run --release -p trajpred-neural --example profile_speed -- lstm|kfu [fused|composed] [warmup] [repeat]`
 
 // the JSON line on standard output is this program's result (read by benches/compare.sh)
 #![allow(clippy::print_stdout)]

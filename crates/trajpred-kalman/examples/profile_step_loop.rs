@@ -2,8 +2,8 @@
 //! (load-independent) and a quick wall-clock figure:
 //!
 //! ```text
-//! cargo build --release -p trajpred-kalman --example step_loop
-//! valgrind --tool=callgrind target/release/examples/step_loop kf 10000
+//! cargo build --release -p trajpred-kalman --example profile_step_loop
+//! valgrind --tool=callgrind target/release/examples/profile_step_loop kf 10000
 //! ```
 //!
 //! The first argument picks the loop (`kf`, `kf_cheap`, `kf_predict`, `kf_update`, `ads`,
