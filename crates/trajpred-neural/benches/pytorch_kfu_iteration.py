@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""PyTorch CPU reference for one KFU-LSTM-Net training iteration (`examples/speed.rs kfu`,
+"""PyTorch CPU reference for one KFU-LSTM-Net training iteration (`examples/profile_speed.rs kfu`,
 criterion bench `kfu_iteration_200_b16`).
 
 The same network, data and loss as our `KfuLstmNet::fit_observed` in that bench:
