@@ -19,6 +19,7 @@ const METHODS: &[&str] = &[
     "gsc",
     "gskf",
     "hmm",
+    "imm",
     "kf-dynamic",
     "kf-dynamic-4d-literal",
     "naive-kf",
@@ -126,7 +127,7 @@ fn loaded_parameters_forecast_bit_for_bit_as_the_fitted_methods() {
         let learns = !file.method(name).expect("saved").params.is_null();
         assert_eq!(
             learns,
-            ["kf-cv", "kf-ca", "gsc", "gskf", "hmm"].contains(name),
+            ["kf-cv", "kf-ca", "gsc", "gskf", "hmm", "imm"].contains(name),
             "{name}"
         );
         let mut compared = 0;

@@ -10,6 +10,7 @@
 //! turn-rate density and the mean sojourn time in a mode maximise the IMM's own likelihood
 //! (the same grid search). See `docs/kalman.md`, section "IMM".
 
+use super::fitted::{At, exact};
 use super::{
     forecast_times_on_mean_interval, invalid, kf_time::maximise, offsets_after, positions_forecast,
 };
@@ -260,6 +261,36 @@ impl Predictor for ImmPredictor {
             })
             .collect();
         positions_forecast(&states, 2)
+    }
+
+    /// The four fitted settings `{"spectral_density", "r", "turn_rate_density",
+    /// "mean_sojourn"}` (fitted, or as given when `fit_noise` is off).
+    fn fitted_params(&self) -> Result<serde_json::Value> {
+        let p = &self.params;
+        Ok(serde_json::json!({
+            "spectral_density": exact(p.spectral_density),
+            "r": exact(p.r),
+            "turn_rate_density": exact(p.turn_rate_density),
+            "mean_sojourn": exact(p.mean_sojourn),
+        }))
+    }
+
+    fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
+        let name = self.name().to_string();
+        let [q, r, turn, sojourn] = At::root(&name, params).fields([
+            "spectral_density",
+            "r",
+            "turn_rate_density",
+            "mean_sojourn",
+        ])?;
+        self.params = ImmParams {
+            spectral_density: q.f64_min(0.0, true)?,
+            r: r.f64_min(0.0, true)?,
+            turn_rate_density: turn.f64_min(0.0, true)?,
+            mean_sojourn: sojourn.f64_min(0.0, true)?,
+            ..self.params
+        };
+        Ok(())
     }
 
     fn fitted_summary(&self) -> Option<String> {
