@@ -10,6 +10,17 @@ fn run(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
+/// [`run`], asserting that the command succeeded (its stderr shown when not).
+fn run_ok(args: &[&str]) -> Output {
+    let out = run(args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("trajpred-cli-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -36,7 +47,7 @@ fn write_track(dir: &std::path::Path, name: &str, n: usize, phase: f64) -> PathB
 fn predict_prints_a_forecast() {
     let dir = scratch("predict");
     let track = write_track(&dir, "track.csv", 40, 0.0);
-    let out = run(&[
+    let out = run_ok(&[
         "predict",
         "--method",
         "poly1",
@@ -45,11 +56,6 @@ fn predict_prints_a_forecast() {
         "--input",
         track.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let text = String::from_utf8(out.stdout).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines[0], "step,t,x,y");
@@ -159,7 +165,7 @@ fn plot_writes_svg_and_png() {
     let track = write_track(&dir, "track.csv", 60, 0.3);
     for ext in ["svg", "png"] {
         let out_file = dir.join(format!("plot.{ext}"));
-        let out = run(&[
+        run_ok(&[
             "plot",
             "--input",
             track.to_str().unwrap(),
@@ -170,11 +176,6 @@ fn plot_writes_svg_and_png() {
             "--output",
             out_file.to_str().unwrap(),
         ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
         let bytes = std::fs::read(&out_file).unwrap();
         if ext == "svg" {
             assert!(bytes.starts_with(b"<svg"));
