@@ -84,6 +84,31 @@ fn close_scalar(a: f64, b: f64, what: &str) {
     );
 }
 
+/// Every step of `steps` (all observed) against filterpy's recorded step: prior, posterior,
+/// innovation, `S`, `K` and log-likelihood.
+fn compare_observed_steps<const N: usize>(
+    steps: &[trajpred_kalman::Step<f64, Const<N>, Const<2>>],
+    expected: &Value,
+) {
+    let (un, u2, u1) = (Const::<N>, Const::<2>, Const::<1>);
+    for (s, e) in steps.iter().zip(expected.as_array().unwrap()) {
+        let u = s.update.as_ref().unwrap();
+        close(&s.prior.mean, &mat(&e["prior_mean"], un, u1), "prior mean");
+        close(
+            &s.prior.covariance,
+            &mat(&e["prior_cov"], un, un),
+            "prior cov",
+        );
+        close(&u.posterior.mean, &mat(&e["mean"], un, u1), "mean");
+        close(&u.posterior.covariance, &mat(&e["cov"], un, un), "cov");
+        close(&u.innovation, &mat(&e["innovation"], u2, u1), "y");
+        close(&u.innovation_covariance, &mat(&e["S"], u2, u2), "S");
+        close(&u.gain, &mat(&e["K"], un, u2), "K");
+        let ll = e["log_likelihood"].as_f64().unwrap();
+        close_scalar(u.log_likelihood(), ll, "ll");
+    }
+}
+
 #[test]
 fn kf_cv_matches_filterpy_step_by_step_with_rts_and_log_likelihood() {
     let fx = load("kf_cv.json");
@@ -238,25 +263,7 @@ fn ekf_range_bearing_matches_filterpy() {
         .map(|z| Some(mat(z, u2, u1)))
         .collect();
     let steps = ekf.filter(&x0, &zs).unwrap();
-    for (s, e) in steps.iter().zip(fx["steps"].as_array().unwrap()) {
-        let u = s.update.as_ref().unwrap();
-        close(&s.prior.mean, &mat(&e["prior_mean"], u4, u1), "prior mean");
-        close(
-            &s.prior.covariance,
-            &mat(&e["prior_cov"], u4, u4),
-            "prior cov",
-        );
-        close(&u.posterior.mean, &mat(&e["mean"], u4, u1), "mean");
-        close(&u.posterior.covariance, &mat(&e["cov"], u4, u4), "cov");
-        close(&u.innovation, &mat(&e["innovation"], u2, u1), "y");
-        close(&u.innovation_covariance, &mat(&e["S"], u2, u2), "S");
-        close(&u.gain, &mat(&e["K"], u4, u2), "K");
-        close_scalar(
-            u.log_likelihood(),
-            e["log_likelihood"].as_f64().unwrap(),
-            "ll",
-        );
-    }
+    compare_observed_steps(&steps, &fx["steps"]);
 }
 
 fn coordinated_turn(fx: &Value) -> CoordinatedTurn<f64> {
@@ -323,26 +330,8 @@ fn ukf_coordinated_turn_60_steps_and_rts_match_filterpy() {
     let (x0, zs) = ct_inputs(&fx);
     assert_eq!(zs.len(), 60);
     let steps = ukf.filter(&x0, &zs).unwrap();
-    let (u5, u2, u1) = (Const::<5>, Const::<2>, Const::<1>);
-    for (s, e) in steps.iter().zip(fx["steps"].as_array().unwrap()) {
-        let u = s.update.as_ref().unwrap();
-        close(&s.prior.mean, &mat(&e["prior_mean"], u5, u1), "prior mean");
-        close(
-            &s.prior.covariance,
-            &mat(&e["prior_cov"], u5, u5),
-            "prior cov",
-        );
-        close(&u.posterior.mean, &mat(&e["mean"], u5, u1), "mean");
-        close(&u.posterior.covariance, &mat(&e["cov"], u5, u5), "cov");
-        close(&u.innovation, &mat(&e["innovation"], u2, u1), "y");
-        close(&u.innovation_covariance, &mat(&e["S"], u2, u2), "S");
-        close(&u.gain, &mat(&e["K"], u5, u2), "K");
-        close_scalar(
-            u.log_likelihood(),
-            e["log_likelihood"].as_f64().unwrap(),
-            "ll",
-        );
-    }
+    let (u5, u1) = (Const::<5>, Const::<1>);
+    compare_observed_steps(&steps, &fx["steps"]);
     let filtered: Vec<_> = steps.iter().map(|s| s.posterior().clone()).collect();
     let smoothed = ukf.smooth(&filtered).unwrap();
     let sm = fx["smoothed_mean"].as_array().unwrap();
