@@ -292,6 +292,25 @@ impl Gsc {
     }
 }
 
+/// Checks a forecast's arguments against the fitted axes ([`check_history`]; `sizes` is the
+/// shortest history and the fitted horizons), then forecasts every axis from the end of
+/// `history` with `forecast_axis(model, that axis's values, index of the last point)`.
+fn forecast_axes<A, R>(
+    history: &Trajectory,
+    horizon: usize,
+    (needed, horizons): (usize, usize),
+    axes: &[A],
+    method: &str,
+    forecast_axis: impl Fn(&A, &[f64], usize) -> Result<R>,
+) -> Result<Vec<R>> {
+    check_history(history, horizon, needed, horizons, axes.len(), method)?;
+    let i = history.len() - 1;
+    axes.iter()
+        .enumerate()
+        .map(|(a, m)| forecast_axis(m, history.axis(a), i))
+        .collect()
+}
+
 fn check_history(
     history: &Trajectory,
     horizon: usize,
@@ -353,21 +372,8 @@ impl Predictor for Gsc {
     }
 
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
-        check_history(
-            history,
-            horizon,
-            self.min_history(),
-            self.params.horizons,
-            self.axes.len(),
-            "gsc",
-        )?;
-        let i = history.len() - 1;
-        let per_axis: Vec<Vec<f64>> = self
-            .axes
-            .iter()
-            .enumerate()
-            .map(|(a, g)| gsc_at(g, history.axis(a), i))
-            .collect::<Result<_>>()?;
+        let sizes = (self.min_history(), self.params.horizons);
+        let per_axis = forecast_axes(history, horizon, sizes, &self.axes, "gsc", gsc_at)?;
         let steps: Vec<Vec<f64>> = (0..horizon)
             .map(|k| per_axis.iter().map(|p| p[k]).collect())
             .collect();
@@ -468,21 +474,11 @@ impl Predictor for Gskf {
     }
 
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
-        check_history(
-            history,
-            horizon,
-            self.min_history(),
-            self.params.horizons,
-            self.axes.len(),
-            "gskf",
-        )?;
-        let i = history.len() - 1;
-        let per_axis: Vec<Gaussian<f64, Dyn>> = self
-            .axes
-            .iter()
-            .enumerate()
-            .map(|(a, f)| f.predict(history.axis(a), i))
-            .collect::<Result<_>>()?;
+        let sizes = (self.min_history(), self.params.horizons);
+        let per_axis: Vec<Gaussian<f64, Dyn>> =
+            forecast_axes(history, horizon, sizes, &self.axes, "gskf", |f, x, i| {
+                f.predict(x, i)
+            })?;
         let steps: Vec<Vec<f64>> = (0..horizon)
             .map(|k| per_axis.iter().map(|g| g.mean[k]).collect())
             .collect();
