@@ -5,6 +5,8 @@
 //! - `kf_step_general_cv4_pos2`: the same step with models that have neither structure the
 //!   KF exploits (a damped constant velocity, positions measured at twice their scale), so
 //!   both filters take their general products;
+//! - `kf_step_dense6_obs3`: the same step on a general dense model (a random stable 6-state
+//!   transition, a dense 3 x 6 observation, random `Q`, `R`; `common::dense_case`);
 //! - `ukf_step_ct5_rb2`: one UKF predict + update on the 5-state coordinated turn with a
 //!   range-bearing observation (filterpy's figure for the same step comes from
 //!   `benches/filterpy_ukf_step.py`).
@@ -16,14 +18,20 @@ mod common;
 use adskalman::{
     CovarianceUpdateMethod, KalmanFilterNoControl, ObservationModel, TransitionModelLinearNoControl,
 };
-use common::{KfCase, cv_case, general_case, ukf_case};
+use common::{Dims, KfCase, cv_case, dense_case, general_case, ukf_case};
 use criterion::measurement::WallTime;
 use criterion::{BenchmarkGroup, Criterion, criterion_group, criterion_main};
+use nalgebra::{DefaultAllocator, DimMin, DimName};
 use std::hint::black_box;
 use trajpred_kalman::{Filter, InputChecks};
 
 /// The full step of both filters on `case`: `trajpred_joseph` and `adskalman_joseph`.
-fn bench_steps(g: &mut BenchmarkGroup<'_, WallTime>, case: &KfCase) {
+fn bench_steps<N: DimName, M: DimName + DimMin<M, Output = M>>(
+    g: &mut BenchmarkGroup<'_, WallTime>,
+    case: &KfCase<N, M>,
+) where
+    DefaultAllocator: Dims<N, M>,
+{
     let ads = KalmanFilterNoControl::new(&case.ads_tr, &case.ads_ob);
     g.bench_function("trajpred_joseph", |b| {
         b.iter(|| {
@@ -105,6 +113,12 @@ fn kf_step_general(c: &mut Criterion) {
     g.finish();
 }
 
+fn kf_step_dense(c: &mut Criterion) {
+    let mut g = c.benchmark_group("kf_step_dense6_obs3");
+    bench_steps(&mut g, &dense_case());
+    g.finish();
+}
+
 fn ukf_step(c: &mut Criterion) {
     let (ukf, state, z) = ukf_case();
     let mut g = c.benchmark_group("ukf_step_ct5_rb2");
@@ -119,5 +133,5 @@ fn ukf_step(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, kf_step, kf_step_general, ukf_step);
+criterion_group!(benches, kf_step, kf_step_general, kf_step_dense, ukf_step);
 criterion_main!(benches);

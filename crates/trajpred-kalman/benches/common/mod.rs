@@ -4,51 +4,81 @@
 #![allow(non_snake_case)]
 
 use adskalman::{ObservationModel, StateAndCovariance, TransitionModelLinearNoControl};
+use nalgebra::allocator::Allocator;
 use nalgebra::{
-    Matrix2, Matrix2x4, Matrix4, Matrix4x2, Matrix5, U2, U4, Vector2, Vector4, Vector5,
+    DefaultAllocator, DimMin, DimName, Matrix2, Matrix2x4, Matrix4, Matrix5, OMatrix, OVector,
+    SMatrix, SVector, U2, U3, U4, U6, Vector2, Vector3, Vector4, Vector5,
 };
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use trajpred_core::Gaussian;
 use trajpred_kalman::motion::{
     KinematicLayout, StateOrder, constant_velocity, position_observation,
 };
 use trajpred_kalman::{
-    CoordinatedTurn, Kf, LinearObservation, LinearTransition, MerweSigmaPoints, RangeBearing, Ukf,
+    CoordinatedTurn, FilterAllocator, Kf, LinearObservation, LinearTransition, MerweSigmaPoints,
+    RangeBearing, Ukf,
 };
 
-/// adskalman's transition model from our `F` and `Q`.
-pub struct AdsTransition {
-    f: Matrix4<f64>,
-    ft: Matrix4<f64>,
-    q: Matrix4<f64>,
+/// The dimensions of a KF problem: `N` states, `M` observed values, sizes known at compile
+/// time as both filters need them.
+pub trait Dims<N: DimName, M: DimName + DimMin<M, Output = M>>:
+    FilterAllocator<N, M> + Allocator<N, N> + Allocator<M, M>
+{
 }
 
-impl TransitionModelLinearNoControl<f64, U4> for AdsTransition {
-    fn F(&self) -> &Matrix4<f64> {
+impl<N: DimName, M: DimName + DimMin<M, Output = M>> Dims<N, M> for DefaultAllocator where
+    DefaultAllocator: FilterAllocator<N, M>
+{
+}
+
+/// adskalman's transition model from our `F` and `Q`.
+pub struct AdsTransition<N: DimName>
+where
+    DefaultAllocator: Allocator<N, N>,
+{
+    f: OMatrix<f64, N, N>,
+    ft: OMatrix<f64, N, N>,
+    q: OMatrix<f64, N, N>,
+}
+
+impl<N: DimName> TransitionModelLinearNoControl<f64, N> for AdsTransition<N>
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N>,
+{
+    fn F(&self) -> &OMatrix<f64, N, N> {
         &self.f
     }
-    fn FT(&self) -> &Matrix4<f64> {
+    fn FT(&self) -> &OMatrix<f64, N, N> {
         &self.ft
     }
-    fn Q(&self) -> &Matrix4<f64> {
+    fn Q(&self) -> &OMatrix<f64, N, N> {
         &self.q
     }
 }
 
 /// adskalman's observation model from our `H` and `R`.
-pub struct AdsObservation {
-    h: Matrix2x4<f64>,
-    ht: Matrix4x2<f64>,
-    r: Matrix2<f64>,
+pub struct AdsObservation<N: DimName, M: DimName + DimMin<M, Output = M>>
+where
+    DefaultAllocator: Dims<N, M>,
+{
+    h: OMatrix<f64, M, N>,
+    ht: OMatrix<f64, N, M>,
+    r: OMatrix<f64, M, M>,
 }
 
-impl ObservationModel<f64, U4, U2> for AdsObservation {
-    fn H(&self) -> &Matrix2x4<f64> {
+impl<N: DimName, M: DimName + DimMin<M, Output = M>> ObservationModel<f64, N, M>
+    for AdsObservation<N, M>
+where
+    DefaultAllocator: Dims<N, M>,
+{
+    fn H(&self) -> &OMatrix<f64, M, N> {
         &self.h
     }
-    fn HT(&self) -> &Matrix4x2<f64> {
+    fn HT(&self) -> &OMatrix<f64, N, M> {
         &self.ht
     }
-    fn R(&self) -> &Matrix2<f64> {
+    fn R(&self) -> &OMatrix<f64, M, M> {
         &self.r
     }
 }
@@ -56,42 +86,53 @@ impl ObservationModel<f64, U4, U2> for AdsObservation {
 /// One KF step problem: our filter (Joseph form, default checks), the same models for
 /// adskalman (build its filter with `KalmanFilterNoControl::new(&ads_tr, &ads_ob)`), the
 /// input state for both and the observation.
-pub struct KfCase {
-    pub kf: Kf<LinearTransition<f64, U4>, LinearObservation<f64, U4, U2>>,
-    pub ads_tr: AdsTransition,
-    pub ads_ob: AdsObservation,
-    pub state: Gaussian<f64, U4>,
-    pub ads_state: StateAndCovariance<f64, U4>,
-    pub z: Vector2<f64>,
+pub struct KfCase<N: DimName = U4, M: DimName + DimMin<M, Output = M> = U2>
+where
+    DefaultAllocator: Dims<N, M>,
+{
+    pub kf: Kf<LinearTransition<f64, N>, LinearObservation<f64, N, M>>,
+    pub ads_tr: AdsTransition<N>,
+    pub ads_ob: AdsObservation<N, M>,
+    pub state: Gaussian<f64, N>,
+    pub ads_state: StateAndCovariance<f64, N>,
+    pub z: OVector<f64, M>,
 }
 
-fn kf_case(
-    tr: LinearTransition<f64, U4>,
-    ob: LinearObservation<f64, U4, U2>,
-    z: Vector2<f64>,
-) -> KfCase {
+fn kf_case<N: DimName, M: DimName + DimMin<M, Output = M>>(
+    tr: LinearTransition<f64, N>,
+    ob: LinearObservation<f64, N, M>,
+    state: Gaussian<f64, N>,
+    z: OVector<f64, M>,
+) -> KfCase<N, M>
+where
+    DefaultAllocator: Dims<N, M>,
+{
     let ads_tr = AdsTransition {
-        f: *tr.f(),
+        f: tr.f().clone(),
         ft: tr.f().transpose(),
-        q: *tr.q(),
+        q: tr.q().clone(),
     };
     let ads_ob = AdsObservation {
-        h: *ob.h(),
+        h: ob.h().clone(),
         ht: ob.h().transpose(),
-        r: *ob.r(),
+        r: ob.r().clone(),
     };
-    let mean = Vector4::new(1.0, 0.5, -2.0, 0.3);
-    let cov = Matrix4::from_diagonal(&Vector4::new(0.5, 0.2, 0.5, 0.2));
+    let ads_state = StateAndCovariance::new(state.mean.clone(), state.covariance.clone());
     KfCase {
         kf: Kf::new(tr, ob).expect("filter"),
         ads_tr,
         ads_ob,
-        state: Gaussian {
-            mean,
-            covariance: cov,
-        },
-        ads_state: StateAndCovariance::new(mean, cov),
+        state,
+        ads_state,
         z,
+    }
+}
+
+/// The input state of the two 4-state problems.
+fn cv_state() -> Gaussian<f64, U4> {
+    Gaussian {
+        mean: Vector4::new(1.0, 0.5, -2.0, 0.3),
+        covariance: Matrix4::from_diagonal(&Vector4::new(0.5, 0.2, 0.5, 0.2)),
     }
 }
 
@@ -101,7 +142,7 @@ pub fn cv_case() -> KfCase {
     let tr = constant_velocity(2, 0.1, 0.5, StateOrder::AxisBlocks).expect("model");
     let layout = KinematicLayout::new(2, 2, StateOrder::AxisBlocks).expect("layout");
     let ob = position_observation(layout, 0.3).expect("model");
-    kf_case(tr, ob, Vector2::new(1.07, -1.95))
+    kf_case(tr, ob, cv_state(), Vector2::new(1.07, -1.95))
 }
 
 /// The same problem changed so that neither model has the structure the KF exploits:
@@ -119,7 +160,40 @@ pub fn general_case() -> KfCase {
     h[(1, 2)] = 2.0;
     let tr = LinearTransition::new(f, *cv.q()).expect("model");
     let ob = LinearObservation::new(h, Matrix2::identity() * 0.3).expect("model");
-    kf_case(tr, ob, Vector2::new(2.14, -3.9))
+    kf_case(tr, ob, cv_state(), Vector2::new(2.14, -3.9))
+}
+
+/// A matrix of independent uniform entries on `[-1, 1)`.
+fn uniform<const R: usize, const C: usize>(rng: &mut ChaCha8Rng) -> SMatrix<f64, R, C> {
+    SMatrix::from_fn(|_, _| rng.random_range(-1.0..1.0))
+}
+
+/// A random symmetric positive definite matrix `B B^T / N + floor I`.
+fn spd<const N: usize>(rng: &mut ChaCha8Rng, floor: f64) -> SMatrix<f64, N, N> {
+    let b = uniform::<N, N>(rng);
+    b * b.transpose() / N as f64 + SMatrix::identity() * floor
+}
+
+/// A general dense model, as issue 26 asks: a random stable 6-state transition (every entry
+/// drawn, then scaled to spectral norm 0.95, so every eigenvalue is inside the unit circle),
+/// a dense 3 x 6 observation matrix, random positive definite `Q`, `R` and input covariance
+/// (seeded: the same problem every run). Nothing in it is structured for either filter.
+pub fn dense_case() -> KfCase<U6, U3> {
+    let mut rng = ChaCha8Rng::seed_from_u64(20261203);
+    let a = uniform::<6, 6>(&mut rng);
+    let norm = a.singular_values().max();
+    let f = a * (0.95 / norm);
+    let h = uniform::<3, 6>(&mut rng);
+    let q = spd::<6>(&mut rng, 0.01);
+    let r = spd::<3>(&mut rng, 0.1);
+    let state = Gaussian {
+        mean: SVector::<f64, 6>::from_fn(|_, _| rng.random_range(-1.0..1.0)),
+        covariance: spd::<6>(&mut rng, 0.05),
+    };
+    let z = h * state.mean + Vector3::new(0.12, -0.07, 0.05);
+    let tr = LinearTransition::new(f, q).expect("model");
+    let ob = LinearObservation::new(h, r).expect("model");
+    kf_case(tr, ob, state, z)
 }
 
 /// The UKF of the benchmark.
