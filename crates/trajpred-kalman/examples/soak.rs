@@ -179,6 +179,49 @@ impl Part {
     }
 }
 
+/// How much to soak: `steps` steps in tracks of at most `track_len`, the invariants checked
+/// every `check_every` steps, the covariance handed to `tamper` first, if set.
+#[derive(Debug, Clone, Copy)]
+pub struct Soak {
+    /// Steps in all.
+    pub steps: u64,
+    /// The longest track.
+    pub track_len: u64,
+    /// Steps between two checks.
+    pub check_every: u64,
+    /// A hook that breaks the covariance before it is checked (tests only).
+    pub tamper: Option<Tamper>,
+}
+
+impl Soak {
+    /// `steps` in tracks of at most `track_len`, checked every `check_every`, untampered.
+    pub fn new(steps: u64, track_len: u64, check_every: u64) -> Self {
+        Soak {
+            steps,
+            track_len,
+            check_every,
+            tamper: None,
+        }
+    }
+
+    /// The same run with `tamper` applied before every check.
+    pub fn tampered(self, tamper: Tamper) -> Self {
+        Soak {
+            tamper: Some(tamper),
+            ..self
+        }
+    }
+}
+
+/// Runs one part, timing it.
+fn timed(run: impl FnOnce(&mut Part)) -> Part {
+    let start = Instant::now();
+    let mut part = Part::default();
+    run(&mut part);
+    part.seconds = start.elapsed().as_secs_f64();
+    part
+}
+
 /// A hook that may tamper with a covariance before it is checked (the identity in a real
 /// run; the tests use it to show that a broken covariance is caught).
 pub type Tamper = fn(&mut DMatrix<f64>);
@@ -230,142 +273,138 @@ fn run_track<D, F>(
 }
 
 /// KF, constant velocity: `steps` steps in tracks of at most `track_len`.
-pub fn soak_kf(
-    steps: u64,
-    track_len: u64,
-    check_every: u64,
-    rng: &mut ChaCha8Rng,
-    tamper: Option<Tamper>,
-) -> Part {
-    let start = Instant::now();
-    let mut part = Part::default();
-    let dt = 0.1;
-    let tr: LinearTransition<f64, U4> =
-        constant_velocity(2, dt, 0.5, StateOrder::AxisBlocks).expect("model");
-    let layout = KinematicLayout::new(2, 2, StateOrder::AxisBlocks).expect("layout");
-    let ob = position_observation(layout, 0.3).expect("model");
-    let kf = Kf::new(tr, ob).expect("filter");
-    let mut left = steps;
-    while left > 0 {
-        let n = left.min(track_len);
-        left -= n;
-        // truth [x, vx, y, vy], white acceleration
-        let mut x = [
-            gauss(rng) * 100.0,
-            gauss(rng) * 5.0,
-            gauss(rng) * 100.0,
-            gauss(rng) * 5.0,
-        ];
-        let state = Gaussian {
-            mean: nalgebra::Vector4::new(x[0], 0.0, x[2], 0.0),
-            covariance: nalgebra::Matrix4::from_diagonal(&nalgebra::Vector4::new(
-                100.0, 25.0, 100.0, 25.0,
-            )),
-        };
-        let sa = 0.5f64.sqrt();
-        let observe = || {
-            for o in [0, 2] {
-                let a = gauss(rng) * sa;
-                x[o] += x[o + 1] * dt + 0.5 * a * dt * dt;
-                x[o + 1] += a * dt;
-            }
-            let z = if rng.random_bool(0.1) {
-                None
-            } else {
-                Some(Vector2::new(
-                    x[0] + gauss(rng) * 0.3f64.sqrt(),
-                    x[2] + gauss(rng) * 0.3f64.sqrt(),
-                ))
+pub fn soak_kf(soak: Soak, rng: &mut ChaCha8Rng) -> Part {
+    timed(|part| {
+        let Soak {
+            steps,
+            track_len,
+            check_every,
+            tamper,
+        } = soak;
+        let dt = 0.1;
+        let tr: LinearTransition<f64, U4> =
+            constant_velocity(2, dt, 0.5, StateOrder::AxisBlocks).expect("model");
+        let layout = KinematicLayout::new(2, 2, StateOrder::AxisBlocks).expect("layout");
+        let ob = position_observation(layout, 0.3).expect("model");
+        let kf = Kf::new(tr, ob).expect("filter");
+        let mut left = steps;
+        while left > 0 {
+            let n = left.min(track_len);
+            left -= n;
+            // truth [x, vx, y, vy], white acceleration
+            let mut x = [
+                gauss(rng) * 100.0,
+                gauss(rng) * 5.0,
+                gauss(rng) * 100.0,
+                gauss(rng) * 5.0,
+            ];
+            let state = Gaussian {
+                mean: nalgebra::Vector4::new(x[0], 0.0, x[2], 0.0),
+                covariance: nalgebra::Matrix4::from_diagonal(&nalgebra::Vector4::new(
+                    100.0, 25.0, 100.0, 25.0,
+                )),
             };
-            (Vector2::new(x[0], x[2]), z)
-        };
-        run_track(&kf, state, n, check_every, observe, &mut part, tamper);
-    }
-    part.seconds = start.elapsed().as_secs_f64();
-    part
+            let sa = 0.5f64.sqrt();
+            let observe = || {
+                for o in [0, 2] {
+                    let a = gauss(rng) * sa;
+                    x[o] += x[o + 1] * dt + 0.5 * a * dt * dt;
+                    x[o + 1] += a * dt;
+                }
+                let z = if rng.random_bool(0.1) {
+                    None
+                } else {
+                    Some(Vector2::new(
+                        x[0] + gauss(rng) * 0.3f64.sqrt(),
+                        x[2] + gauss(rng) * 0.3f64.sqrt(),
+                    ))
+                };
+                (Vector2::new(x[0], x[2]), z)
+            };
+            run_track(&kf, state, n, check_every, observe, part, tamper);
+        }
+    })
 }
 
 /// UKF, coordinated turn; range-bearing observations on even tracks, positions on odd ones.
-pub fn soak_ukf(
-    steps: u64,
-    track_len: u64,
-    check_every: u64,
-    rng: &mut ChaCha8Rng,
-    tamper: Option<Tamper>,
-) -> Part {
-    let start = Instant::now();
-    let mut part = Part::default();
-    let dt = 0.5;
-    let ct = CoordinatedTurn::<f64>::new(dt, 0.2, 1e-3).expect("model");
-    let truth = CoordinatedTurn::<f64>::new(dt, 0.0, 0.0).expect("model");
-    let (range_var, bearing_var, pos_var) = (0.5, 1e-4, 4.0);
-    let rb =
-        RangeBearing::new(Vector2::new(0.0, 0.0), 0, 2, range_var, bearing_var).expect("model");
-    let mut h = Matrix2x5::zeros();
-    h[(0, 0)] = 1.0;
-    h[(1, 2)] = 1.0;
-    let pos =
-        LinearObservation::<f64, U5, U2>::new(h, Matrix2::identity() * pos_var).expect("model");
-    let ukf_rb = Ukf::new(ct.clone(), rb, MerweSigmaPoints::new(0.5, 2.0, -2.0)).expect("ukf");
-    let ukf_pos = Ukf::new(ct, pos, MerweSigmaPoints::new(0.5, 2.0, -2.0)).expect("ukf");
-    let mut left = steps;
-    let mut track = 0u64;
-    while left > 0 {
-        let n = left.min(track_len);
-        left -= n;
-        // truth: a turning target; the turn rate is mean-reverting around +-0.05 rad/s
-        let mut x = nalgebra::Vector5::new(
-            100.0 + gauss(rng) * 20.0,
-            7.0,
-            -50.0 + gauss(rng) * 20.0,
-            2.5,
-            0.05,
-        );
-        let mut target = 0.05;
-        let state = Gaussian {
-            mean: nalgebra::Vector5::new(x[0], 5.0, x[2], 0.0, 0.0),
-            covariance: nalgebra::Matrix5::from_diagonal(&nalgebra::Vector5::new(
-                25.0, 25.0, 25.0, 25.0, 0.01,
-            )),
-        };
-        let range_bearing = track.is_multiple_of(2);
-        let observe = || {
-            if rng.random_bool(0.002) {
-                target = -target;
-            }
-            x = truth.transition(&x).expect("truth");
-            x[4] += 0.05 * (target - x[4]) + gauss(rng) * 1e-3;
-            x[1] += gauss(rng) * 0.1;
-            x[3] += gauss(rng) * 0.1;
-            let pos = Vector2::new(x[0], x[2]);
-            if rng.random_bool(0.1) {
-                return (pos, None);
-            }
-            let z = if range_bearing {
-                let (dx, dy) = (x[0], x[2]);
-                Vector2::new(
-                    dx.hypot(dy) + gauss(rng) * range_var.sqrt(),
-                    trajpred_kalman::motion::wrap_angle(
-                        dy.atan2(dx) + gauss(rng) * bearing_var.sqrt(),
-                    ),
-                )
-            } else {
-                Vector2::new(
-                    x[0] + gauss(rng) * pos_var.sqrt(),
-                    x[2] + gauss(rng) * pos_var.sqrt(),
-                )
+pub fn soak_ukf(soak: Soak, rng: &mut ChaCha8Rng) -> Part {
+    timed(|part| {
+        let Soak {
+            steps,
+            track_len,
+            check_every,
+            tamper,
+        } = soak;
+        let dt = 0.5;
+        let ct = CoordinatedTurn::<f64>::new(dt, 0.2, 1e-3).expect("model");
+        let truth = CoordinatedTurn::<f64>::new(dt, 0.0, 0.0).expect("model");
+        let (range_var, bearing_var, pos_var) = (0.5, 1e-4, 4.0);
+        let rb =
+            RangeBearing::new(Vector2::new(0.0, 0.0), 0, 2, range_var, bearing_var).expect("model");
+        let mut h = Matrix2x5::zeros();
+        h[(0, 0)] = 1.0;
+        h[(1, 2)] = 1.0;
+        let pos =
+            LinearObservation::<f64, U5, U2>::new(h, Matrix2::identity() * pos_var).expect("model");
+        let ukf_rb = Ukf::new(ct.clone(), rb, MerweSigmaPoints::new(0.5, 2.0, -2.0)).expect("ukf");
+        let ukf_pos = Ukf::new(ct, pos, MerweSigmaPoints::new(0.5, 2.0, -2.0)).expect("ukf");
+        let mut left = steps;
+        let mut track = 0u64;
+        while left > 0 {
+            let n = left.min(track_len);
+            left -= n;
+            // truth: a turning target; the turn rate is mean-reverting around +-0.05 rad/s
+            let mut x = nalgebra::Vector5::new(
+                100.0 + gauss(rng) * 20.0,
+                7.0,
+                -50.0 + gauss(rng) * 20.0,
+                2.5,
+                0.05,
+            );
+            let mut target = 0.05;
+            let state = Gaussian {
+                mean: nalgebra::Vector5::new(x[0], 5.0, x[2], 0.0, 0.0),
+                covariance: nalgebra::Matrix5::from_diagonal(&nalgebra::Vector5::new(
+                    25.0, 25.0, 25.0, 25.0, 0.01,
+                )),
             };
-            (pos, Some(z))
-        };
-        if range_bearing {
-            run_track(&ukf_rb, state, n, check_every, observe, &mut part, tamper);
-        } else {
-            run_track(&ukf_pos, state, n, check_every, observe, &mut part, tamper);
+            let range_bearing = track.is_multiple_of(2);
+            let observe = || {
+                if rng.random_bool(0.002) {
+                    target = -target;
+                }
+                x = truth.transition(&x).expect("truth");
+                x[4] += 0.05 * (target - x[4]) + gauss(rng) * 1e-3;
+                x[1] += gauss(rng) * 0.1;
+                x[3] += gauss(rng) * 0.1;
+                let pos = Vector2::new(x[0], x[2]);
+                if rng.random_bool(0.1) {
+                    return (pos, None);
+                }
+                let z = if range_bearing {
+                    let (dx, dy) = (x[0], x[2]);
+                    Vector2::new(
+                        dx.hypot(dy) + gauss(rng) * range_var.sqrt(),
+                        trajpred_kalman::motion::wrap_angle(
+                            dy.atan2(dx) + gauss(rng) * bearing_var.sqrt(),
+                        ),
+                    )
+                } else {
+                    Vector2::new(
+                        x[0] + gauss(rng) * pos_var.sqrt(),
+                        x[2] + gauss(rng) * pos_var.sqrt(),
+                    )
+                };
+                (pos, Some(z))
+            };
+            if range_bearing {
+                run_track(&ukf_rb, state, n, check_every, observe, part, tamper);
+            } else {
+                run_track(&ukf_pos, state, n, check_every, observe, part, tamper);
+            }
+            track += 1;
         }
-        track += 1;
-    }
-    part.seconds = start.elapsed().as_secs_f64();
-    part
+    })
 }
 
 type CvKf = Kf<LinearTransition<f64, U4>, LinearObservation<f64, U4, U2>>;
@@ -385,114 +424,112 @@ fn cv_filter(q: f64, r: f64) -> impl Fn(f64) -> Result<CvKf, KalmanError> {
 /// The driver over irregular times (70 % of steps repeat the previous interval, the others
 /// draw a new one in `[0.01, 3)` s; 10 % of observations missing), in chunks of `chunk`
 /// times so memory stays bounded.
-pub fn soak_driver(
-    steps: u64,
-    track_len: u64,
-    check_every: u64,
-    rng: &mut ChaCha8Rng,
-    tamper: Option<Tamper>,
-) -> Part {
-    let start = Instant::now();
-    let mut part = Part::default();
-    let (q, r) = (0.5, 0.3);
-    let chunk = 10_000usize;
-    let mut left = steps;
-    while left > 0 {
-        let n = left.min(track_len);
-        left -= n;
-        part.tracks += 1;
-        let mut x = [
-            gauss(rng) * 100.0,
-            gauss(rng) * 5.0,
-            gauss(rng) * 100.0,
-            gauss(rng) * 5.0,
-        ];
-        let init = Gaussian {
-            mean: nalgebra::Vector4::new(x[0], 0.0, x[2], 0.0),
-            covariance: nalgebra::Matrix4::from_diagonal(&nalgebra::Vector4::new(
-                100.0, 25.0, 100.0, 25.0,
-            )),
-        };
-        let mut f = Timed::new(cv_filter(q, r), init);
-        let (mut t, mut dt) = (0.0f64, 0.1f64);
-        let mut done = 0u64;
-        let mut times = Vec::with_capacity(chunk + 1);
-        let mut obs: Vec<Option<Vector2<f64>>> = Vec::with_capacity(chunk + 1);
-        let mut truth: Vec<Vector2<f64>> = Vec::with_capacity(chunk + 1);
-        while done < n {
-            let m = (n - done).min(chunk as u64) as usize;
-            times.clear();
-            obs.clear();
-            truth.clear();
-            times.push(t);
-            obs.push(None);
-            truth.push(Vector2::new(x[0], x[2]));
-            for _ in 0..m {
-                if !rng.random_bool(0.7) {
-                    dt = rng.random_range(0.01..3.0);
-                }
-                t += dt;
-                for o in [0, 2] {
-                    // exact continuous white-noise acceleration would need the joint draw;
-                    // an Euler step is close enough for a truth to track
-                    let a = gauss(rng) * (q / dt).sqrt();
-                    x[o] += x[o + 1] * dt + 0.5 * a * dt * dt;
-                    x[o + 1] += a * dt;
-                }
+pub fn soak_driver(soak: Soak, rng: &mut ChaCha8Rng) -> Part {
+    timed(|part| {
+        let Soak {
+            steps,
+            track_len,
+            check_every,
+            tamper,
+        } = soak;
+        let (q, r) = (0.5, 0.3);
+        let chunk = 10_000usize;
+        let mut left = steps;
+        while left > 0 {
+            let n = left.min(track_len);
+            left -= n;
+            part.tracks += 1;
+            let mut x = [
+                gauss(rng) * 100.0,
+                gauss(rng) * 5.0,
+                gauss(rng) * 100.0,
+                gauss(rng) * 5.0,
+            ];
+            let init = Gaussian {
+                mean: nalgebra::Vector4::new(x[0], 0.0, x[2], 0.0),
+                covariance: nalgebra::Matrix4::from_diagonal(&nalgebra::Vector4::new(
+                    100.0, 25.0, 100.0, 25.0,
+                )),
+            };
+            let mut f = Timed::new(cv_filter(q, r), init);
+            let (mut t, mut dt) = (0.0f64, 0.1f64);
+            let mut done = 0u64;
+            let mut times = Vec::with_capacity(chunk + 1);
+            let mut obs: Vec<Option<Vector2<f64>>> = Vec::with_capacity(chunk + 1);
+            let mut truth: Vec<Vector2<f64>> = Vec::with_capacity(chunk + 1);
+            while done < n {
+                let m = (n - done).min(chunk as u64) as usize;
+                times.clear();
+                obs.clear();
+                truth.clear();
                 times.push(t);
+                obs.push(None);
                 truth.push(Vector2::new(x[0], x[2]));
-                obs.push(if rng.random_bool(0.1) {
-                    None
-                } else {
-                    Some(Vector2::new(
-                        x[0] + gauss(rng) * r.sqrt(),
-                        x[2] + gauss(rng) * r.sqrt(),
-                    ))
-                });
-            }
-            let base = done;
-            let mut checks = Part::default();
-            let res = drive(&mut f, &times, &obs, |k, f| {
-                let at = base + k as u64;
-                if at.is_multiple_of(check_every) || k == m {
-                    checks.nees(f.state(), truth[k]);
-                    match tamper {
-                        None => checks.check(&f.state().covariance, at),
-                        Some(tm) => {
-                            let p = &f.state().covariance;
-                            let mut d = DMatrix::from_fn(4, 4, |i, j| p[(i, j)]);
-                            tm(&mut d);
-                            checks.check(&d, at);
+                for _ in 0..m {
+                    if !rng.random_bool(0.7) {
+                        dt = rng.random_range(0.01..3.0);
+                    }
+                    t += dt;
+                    for o in [0, 2] {
+                        // exact continuous white-noise acceleration would need the joint draw;
+                        // an Euler step is close enough for a truth to track
+                        let a = gauss(rng) * (q / dt).sqrt();
+                        x[o] += x[o + 1] * dt + 0.5 * a * dt * dt;
+                        x[o + 1] += a * dt;
+                    }
+                    times.push(t);
+                    truth.push(Vector2::new(x[0], x[2]));
+                    obs.push(if rng.random_bool(0.1) {
+                        None
+                    } else {
+                        Some(Vector2::new(
+                            x[0] + gauss(rng) * r.sqrt(),
+                            x[2] + gauss(rng) * r.sqrt(),
+                        ))
+                    });
+                }
+                let base = done;
+                let mut checks = Part::default();
+                let res = drive(&mut f, &times, &obs, |k, f| {
+                    let at = base + k as u64;
+                    if at.is_multiple_of(check_every) || k == m {
+                        checks.nees(f.state(), truth[k]);
+                        match tamper {
+                            None => checks.check(&f.state().covariance, at),
+                            Some(tm) => {
+                                let p = &f.state().covariance;
+                                let mut d = DMatrix::from_fn(4, 4, |i, j| p[(i, j)]);
+                                tm(&mut d);
+                                checks.check(&d, at);
+                            }
+                        }
+                        let ll = f.log_likelihood();
+                        if !ll.is_finite() {
+                            checks.fail(format!("step {at}: total log-likelihood {ll}"));
                         }
                     }
-                    let ll = f.log_likelihood();
-                    if !ll.is_finite() {
-                        checks.fail(format!("step {at}: total log-likelihood {ll}"));
+                    Ok(())
+                });
+                part.checks += checks.checks;
+                part.violations += checks.violations;
+                part.max_trace = part.max_trace.max(checks.max_trace);
+                part.nees_sum += checks.nees_sum;
+                part.nees_n += checks.nees_n;
+                part.messages.extend(checks.messages.into_iter().take(5));
+                match res {
+                    Ok(estimates) => {
+                        part.steps += estimates.len() as u64;
+                        part.updates += obs[1..].iter().filter(|z| z.is_some()).count() as u64;
+                    }
+                    Err(e) => {
+                        part.error(&e);
+                        break;
                     }
                 }
-                Ok(())
-            });
-            part.checks += checks.checks;
-            part.violations += checks.violations;
-            part.max_trace = part.max_trace.max(checks.max_trace);
-            part.nees_sum += checks.nees_sum;
-            part.nees_n += checks.nees_n;
-            part.messages.extend(checks.messages.into_iter().take(5));
-            match res {
-                Ok(estimates) => {
-                    part.steps += estimates.len() as u64;
-                    part.updates += obs[1..].iter().filter(|z| z.is_some()).count() as u64;
-                }
-                Err(e) => {
-                    part.error(&e);
-                    break;
-                }
+                done += m as u64;
             }
-            done += m as u64;
         }
-    }
-    part.seconds = start.elapsed().as_secs_f64();
-    part
+    })
 }
 
 /// The IMM: constant-velocity (KF) and coordinated-turn (EKF) modes on `[x, vx, y, vy,
@@ -501,102 +538,101 @@ pub fn soak_driver(
 /// average, switching on and off at random), positions observed with variance 4 (10 %
 /// missing). Checks the combined covariance and every mode's; the log-likelihood of every
 /// observed step must be finite and the mode probabilities must sum to 1.
-pub fn soak_imm(
-    steps: u64,
-    track_len: u64,
-    check_every: u64,
-    rng: &mut ChaCha8Rng,
-    tamper: Option<Tamper>,
-) -> Part {
-    let start = Instant::now();
-    let mut part = Part::default();
-    let (dt, q, pos_var) = (1.0, 0.05, 4.0);
-    let obs = turn_state_position_observation::<f64>(pos_var).expect("model");
-    let cv = Kf::new(
-        constant_velocity_in_turn_state::<f64>(dt, q).expect("model"),
-        obs.clone(),
-    )
-    .expect("kf");
-    let ct = Ekf::new(
-        coordinated_turn_continuous::<f64>(dt, q, 1e-4).expect("model"),
-        obs,
-    )
-    .expect("ekf");
-    let modes: Vec<Box<dyn Filter<f64, U5, U2>>> = vec![Box::new(cv), Box::new(ct)];
-    let imm = Imm::new(modes, uniform_switching(2, dt, 30.0).expect("matrix")).expect("imm");
-    let truth = CoordinatedTurn::<f64>::new(dt, 0.0, 0.0).expect("model");
-    let mut left = steps;
-    while left > 0 {
-        let n = left.min(track_len);
-        left -= n;
-        part.tracks += 1;
-        let mut x = nalgebra::Vector5::new(gauss(rng) * 100.0, 8.0, gauss(rng) * 100.0, 0.0, 0.0);
-        let start = Gaussian {
-            mean: nalgebra::Vector5::new(x[0], 0.0, x[2], 0.0, 0.0),
-            covariance: nalgebra::Matrix5::from_diagonal(&nalgebra::Vector5::new(
-                25.0, 25.0, 25.0, 25.0, 0.01,
-            )),
-        };
-        let mut state = ImmState::uniform(start, 2).expect("state");
-        for k in 1..=n {
-            // turns of about 20 s, straight legs of about 1000 s, speed kept near 8 m/s
-            if x[4] != 0.0 && rng.random_bool(0.05) {
-                x[4] = 0.0;
-            } else if x[4] == 0.0 && rng.random_bool(0.001) {
-                x[4] = if rng.random_bool(0.5) { 0.05 } else { -0.05 };
-            }
-            x = truth.transition(&x).expect("truth");
-            let speed = x[1].hypot(x[3]).max(1e-9);
-            x[1] += gauss(rng) * 0.05 + 0.01 * (8.0 / speed - 1.0) * x[1];
-            x[3] += gauss(rng) * 0.05 + 0.01 * (8.0 / speed - 1.0) * x[3];
-            let pos = Vector2::new(x[0], x[2]);
-            let z = (!rng.random_bool(0.1)).then(|| {
-                Vector2::new(
-                    x[0] + gauss(rng) * pos_var.sqrt(),
-                    x[2] + gauss(rng) * pos_var.sqrt(),
-                )
-            });
-            let step = match imm.step(&state, z.as_ref()) {
-                Ok(s) => s,
-                Err(e) => {
-                    part.error(&e);
-                    break;
-                }
+pub fn soak_imm(soak: Soak, rng: &mut ChaCha8Rng) -> Part {
+    timed(|part| {
+        let Soak {
+            steps,
+            track_len,
+            check_every,
+            tamper,
+        } = soak;
+        let (dt, q, pos_var) = (1.0, 0.05, 4.0);
+        let obs = turn_state_position_observation::<f64>(pos_var).expect("model");
+        let cv = Kf::new(
+            constant_velocity_in_turn_state::<f64>(dt, q).expect("model"),
+            obs.clone(),
+        )
+        .expect("kf");
+        let ct = Ekf::new(
+            coordinated_turn_continuous::<f64>(dt, q, 1e-4).expect("model"),
+            obs,
+        )
+        .expect("ekf");
+        let modes: Vec<Box<dyn Filter<f64, U5, U2>>> = vec![Box::new(cv), Box::new(ct)];
+        let imm = Imm::new(modes, uniform_switching(2, dt, 30.0).expect("matrix")).expect("imm");
+        let truth = CoordinatedTurn::<f64>::new(dt, 0.0, 0.0).expect("model");
+        let mut left = steps;
+        while left > 0 {
+            let n = left.min(track_len);
+            left -= n;
+            part.tracks += 1;
+            let mut x =
+                nalgebra::Vector5::new(gauss(rng) * 100.0, 8.0, gauss(rng) * 100.0, 0.0, 0.0);
+            let start = Gaussian {
+                mean: nalgebra::Vector5::new(x[0], 0.0, x[2], 0.0, 0.0),
+                covariance: nalgebra::Matrix5::from_diagonal(&nalgebra::Vector5::new(
+                    25.0, 25.0, 25.0, 25.0, 0.01,
+                )),
             };
-            part.count_step(k, z.is_some(), step.log_likelihood);
-            let sum: f64 = step.state.probabilities().iter().sum();
-            if (sum - 1.0).abs() > 1e-12 {
-                part.fail(format!("step {k}: mode probabilities sum to {sum}"));
-            }
-            state = step.state;
-            if k.is_multiple_of(check_every) || k == n {
-                let combined = match state.combined() {
-                    Ok(c) => c,
+            let mut state = ImmState::uniform(start, 2).expect("state");
+            for k in 1..=n {
+                // turns of about 20 s, straight legs of about 1000 s, speed kept near 8 m/s
+                if x[4] != 0.0 && rng.random_bool(0.05) {
+                    x[4] = 0.0;
+                } else if x[4] == 0.0 && rng.random_bool(0.001) {
+                    x[4] = if rng.random_bool(0.5) { 0.05 } else { -0.05 };
+                }
+                x = truth.transition(&x).expect("truth");
+                let speed = x[1].hypot(x[3]).max(1e-9);
+                x[1] += gauss(rng) * 0.05 + 0.01 * (8.0 / speed - 1.0) * x[1];
+                x[3] += gauss(rng) * 0.05 + 0.01 * (8.0 / speed - 1.0) * x[3];
+                let pos = Vector2::new(x[0], x[2]);
+                let z = (!rng.random_bool(0.1)).then(|| {
+                    Vector2::new(
+                        x[0] + gauss(rng) * pos_var.sqrt(),
+                        x[2] + gauss(rng) * pos_var.sqrt(),
+                    )
+                });
+                let step = match imm.step(&state, z.as_ref()) {
+                    Ok(s) => s,
                     Err(e) => {
                         part.error(&e);
                         break;
                     }
                 };
-                part.nees(&combined, pos);
-                for g in state.modes() {
-                    if let Err(e) = check_cov(&g.covariance) {
-                        part.fail(format!("step {k}: mode covariance {e}"));
-                    }
+                part.count_step(k, z.is_some(), step.log_likelihood);
+                let sum: f64 = step.state.probabilities().iter().sum();
+                if (sum - 1.0).abs() > 1e-12 {
+                    part.fail(format!("step {k}: mode probabilities sum to {sum}"));
                 }
-                match tamper {
-                    None => part.check(&combined.covariance, k),
-                    Some(t) => {
-                        let p = &combined.covariance;
-                        let mut d = DMatrix::from_fn(5, 5, |i, j| p[(i, j)]);
-                        t(&mut d);
-                        part.check(&d, k);
+                state = step.state;
+                if k.is_multiple_of(check_every) || k == n {
+                    let combined = match state.combined() {
+                        Ok(c) => c,
+                        Err(e) => {
+                            part.error(&e);
+                            break;
+                        }
+                    };
+                    part.nees(&combined, pos);
+                    for g in state.modes() {
+                        if let Err(e) = check_cov(&g.covariance) {
+                            part.fail(format!("step {k}: mode covariance {e}"));
+                        }
+                    }
+                    match tamper {
+                        None => part.check(&combined.covariance, k),
+                        Some(t) => {
+                            let p = &combined.covariance;
+                            let mut d = DMatrix::from_fn(5, 5, |i, j| p[(i, j)]);
+                            t(&mut d);
+                            part.check(&d, k);
+                        }
                     }
                 }
             }
         }
-    }
-    part.seconds = start.elapsed().as_secs_f64();
-    part
+    })
 }
 
 /// Prints one part's figures.
@@ -635,22 +671,20 @@ fn main() {
         "soak: {total} steps, seed {seed}, tracks of up to {track_len}, checks every {check_every}"
     );
     println!("VmRSS at start: {rss0:?} KiB");
-    let kf = soak_kf(total * 3 / 10, track_len, check_every, &mut rng, None);
+    let soak = |steps| Soak::new(steps, track_len, check_every);
+    let kf = soak_kf(soak(total * 3 / 10), &mut rng);
     let rss1 = vm_rss_kib();
     print("KF", &kf);
     println!("VmRSS after KF: {rss1:?} KiB");
-    let ukf = soak_ukf(total / 4, track_len, check_every, &mut rng, None);
+    let ukf = soak_ukf(soak(total / 4), &mut rng);
     print("UKF", &ukf);
     println!("VmRSS after UKF: {:?} KiB", vm_rss_kib());
-    let drv = soak_driver(total / 4, track_len, check_every, &mut rng, None);
+    let drv = soak_driver(soak(total / 4), &mut rng);
     print("driver", &drv);
     println!("VmRSS after driver: {:?} KiB", vm_rss_kib());
     let imm = soak_imm(
-        total - total * 3 / 10 - total / 4 - total / 4,
-        track_len,
-        check_every,
+        soak(total - total * 3 / 10 - total / 4 - total / 4),
         &mut rng,
-        None,
     );
     print("IMM", &imm);
     let rss2 = vm_rss_kib();

@@ -11,7 +11,7 @@ mod soak;
 use nalgebra::{DMatrix, Matrix3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use soak::{Part, check_cov, soak_driver, soak_imm, soak_kf, soak_ukf};
+use soak::{Part, Soak, check_cov, soak_driver, soak_imm, soak_kf, soak_ukf};
 
 fn assert_clean(name: &str, p: &Part, steps: u64) {
     assert_eq!(p.steps, steps, "{name}: steps ({:?})", p.messages);
@@ -31,7 +31,7 @@ fn assert_clean(name: &str, p: &Part, steps: u64) {
 #[test]
 fn a_short_soak_keeps_every_invariant() {
     let mut rng = ChaCha8Rng::seed_from_u64(11);
-    let kf = soak_kf(40_000, 10_000, 100, &mut rng, None);
+    let kf = soak_kf(Soak::new(40_000, 10_000, 100), &mut rng);
     assert_clean("KF", &kf, 40_000);
     assert_eq!(kf.tracks, 4);
     // the linear filters on their own model are consistent: position NEES about 2
@@ -41,10 +41,10 @@ fn a_short_soak_keeps_every_invariant() {
         "KF NEES {}",
         kf.mean_nees()
     );
-    let ukf = soak_ukf(30_000, 10_000, 100, &mut rng, None);
+    let ukf = soak_ukf(Soak::new(30_000, 10_000, 100), &mut rng);
     assert_clean("UKF", &ukf, 30_000);
     assert_eq!(ukf.tracks, 3, "range-bearing, position, range-bearing");
-    let drv = soak_driver(30_000, 10_000, 100, &mut rng, None);
+    let drv = soak_driver(Soak::new(30_000, 10_000, 100), &mut rng);
     assert_clean("driver", &drv, 30_000);
     assert!(
         (1.0..4.0).contains(&drv.mean_nees()),
@@ -58,7 +58,7 @@ fn a_short_soak_keeps_every_invariant() {
         "UKF NEES {}",
         ukf.mean_nees()
     );
-    let imm = soak_imm(20_000, 10_000, 100, &mut rng, None);
+    let imm = soak_imm(Soak::new(20_000, 10_000, 100), &mut rng);
     assert_clean("IMM", &imm, 20_000);
     assert_eq!(imm.tracks, 2);
     // the IMM's combined covariance is the mixture's: NEES near 2 as well
@@ -105,18 +105,30 @@ fn make_indefinite(p: &mut DMatrix<f64>) {
 #[test]
 fn a_broken_covariance_fails_the_soak() {
     let mut rng = ChaCha8Rng::seed_from_u64(12);
-    let kf = soak_kf(2_000, 1_000, 100, &mut rng, Some(break_symmetry));
+    let kf = soak_kf(
+        Soak::new(2_000, 1_000, 100).tampered(break_symmetry),
+        &mut rng,
+    );
     assert_eq!(kf.violations, kf.checks);
     assert!(kf.messages[0].contains("asymmetric"), "{:?}", kf.messages);
-    let ukf = soak_ukf(2_000, 1_000, 100, &mut rng, Some(make_indefinite));
+    let ukf = soak_ukf(
+        Soak::new(2_000, 1_000, 100).tampered(make_indefinite),
+        &mut rng,
+    );
     assert_eq!(ukf.violations, ukf.checks);
     assert!(ukf.messages[0].contains("not PSD"), "{:?}", ukf.messages);
-    let drv = soak_driver(2_000, 1_000, 100, &mut rng, Some(break_symmetry));
+    let drv = soak_driver(
+        Soak::new(2_000, 1_000, 100).tampered(break_symmetry),
+        &mut rng,
+    );
     assert!(
         drv.violations > 0 && drv.violations == drv.checks,
         "{drv:?}"
     );
-    let imm = soak_imm(2_000, 1_000, 100, &mut rng, Some(make_indefinite));
+    let imm = soak_imm(
+        Soak::new(2_000, 1_000, 100).tampered(make_indefinite),
+        &mut rng,
+    );
     assert_eq!(imm.violations, imm.checks, "{:?}", imm.messages);
     assert!(imm.messages[0].contains("not PSD"), "{:?}", imm.messages);
 }
