@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! cargo xtask reproduce [--paper <slug>|all] [--quick] [--check | --bless]
-//!                       [--data DIR] [--out DIR] [--seed N]
+//!                       [--data DIR] [--out DIR] [--seed N] [--jobs N]
 //! ```
 //!
 //! The slugs are those of `trajpred_repro::Paper::ALL`. A run is written to `--out`
@@ -17,7 +17,7 @@ use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use trajpred_repro::{
-    Context, Paper, ReproError, bless, check_paper, run_info, run_paper, write_run,
+    Context, Paper, ReproError, bless, check_paper, run_info, run_papers, write_run,
 };
 
 #[derive(Parser)]
@@ -70,6 +70,10 @@ enum Command {
         /// Base seed of every random choice.
         #[arg(long, default_value_t = Context::default().seed)]
         seed: u64,
+        /// Papers run at once (default: the machine's cores). Each paper's numbers do not
+        /// depend on it: every experiment is seeded from --seed alone.
+        #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+        jobs: Option<u64>,
     },
 }
 
@@ -124,6 +128,7 @@ fn main() -> Result<()> {
             data,
             out,
             seed,
+            jobs,
         } => {
             let root = root();
             let data = under(&root, data);
@@ -152,10 +157,19 @@ fn main() -> Result<()> {
             let rev = revision(&root);
             let start = Instant::now();
             let mut failed = Vec::new();
-            for p in paper.0 {
+            let papers = paper.0;
+            let jobs = jobs.map_or_else(
+                || std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get),
+                |j| usize::try_from(j).unwrap_or(usize::MAX),
+            );
+            eprintln!(
+                "reproducing {} paper(s), up to {jobs} at once",
+                papers.len()
+            );
+            let results = run_papers(&papers, &ctx, jobs);
+            for (&p, run) in papers.iter().zip(results) {
                 eprintln!("== {}", p.title());
-                let (result, wall) =
-                    run_paper(p, &ctx).with_context(|| format!("reproducing {}", p.slug()))?;
+                let (result, wall) = run.with_context(|| format!("reproducing {}", p.slug()))?;
                 let info = run_info(p, &ctx, &result, wall, &rev);
                 write_run(p, &result, &info, &out)
                     .with_context(|| format!("writing {} under {}", p.slug(), out.display()))?;

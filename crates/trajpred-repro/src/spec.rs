@@ -37,6 +37,10 @@ pub struct Spec {
     pub anchor: String,
     /// Why this paper's numbers and ours differ (the results index).
     pub explanation: String,
+    /// Its claims compare wall times, so it runs with no other paper at once
+    /// ([`crate::run_papers`]).
+    #[serde(default)]
+    pub runs_alone: bool,
     /// The real datasets the paper reads.
     #[serde(default)]
     pub datasets: Vec<DatasetSpec>,

@@ -12,10 +12,9 @@
 
 use super::train::{Case, observe, points, seed_of, train_len};
 use super::{Budget, Params};
+use crate::pool::map_in_parallel;
 use crate::runner::{Computed, Row};
 use crate::{ReproError, Result, Value};
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 use trajpred_core::Trajectory;
 use trajpred_neural::{
@@ -242,34 +241,9 @@ pub(super) fn run(
     }
     // two workers pull jobs in order; each job is seeded, so the results do not depend on
     // which worker ran it
-    let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<Result<Outcome>>>> =
-        Mutex::new((0..jobs.len()).map(|_| None).collect());
-    std::thread::scope(|scope| {
-        for _ in 0..2 {
-            scope.spawn(|| {
-                loop {
-                    let i = next.fetch_add(1, Ordering::Relaxed);
-                    let Some(job) = jobs.get(i) else { break };
-                    let r = run_job(job, p, s);
-                    if let Ok(mut g) = results.lock() {
-                        g[i] = Some(r);
-                    }
-                }
-            });
-        }
-    });
-    let results = results.into_inner().map_err(|_| ReproError::Experiment {
-        experiment: "kfu-lstm/fair".into(),
-        reason: "a worker panicked".into(),
-    })?;
-    let mut done: Vec<Outcome> = Vec::with_capacity(jobs.len());
-    for r in results {
-        done.push(r.ok_or_else(|| ReproError::Experiment {
-            experiment: "kfu-lstm/fair".into(),
-            reason: "a job did not run".into(),
-        })??);
-    }
+    let done = map_in_parallel(&jobs, 2, |job| run_job(job, p, s))
+        .into_iter()
+        .collect::<Result<Vec<Outcome>>>()?;
     summarise(cases, &jobs, &done, s, out);
     Ok(())
 }
