@@ -55,7 +55,7 @@
 //! ```
 
 use crate::dataset::{Dataset, Segment, Segmentation};
-use crate::harness::Split;
+use crate::harness::{self, Split};
 use crate::protocol::{self, MethodSpec, Progress, Protocol};
 use crate::registry::{MethodOptions, all_methods, build};
 use serde::{Deserialize, Serialize};
@@ -326,6 +326,7 @@ pub fn fit(
     check_exportable(&protocol.methods)?;
     let (train, _) = protocol::split(protocol, segments).map_err(whole)?;
     let train_tr: Vec<Trajectory> = train.iter().map(|s| s.trajectory.clone()).collect();
+    let groups = harness::group_ids(&train);
     let mut methods = Vec::with_capacity(protocol.methods.len());
     for m in &protocol.methods {
         let fail = |error| ParamsError::Fit {
@@ -334,8 +335,8 @@ pub fn fit(
         };
         progress.start(&format!("fit {}", m.label), 1);
         let t0 = Instant::now();
-        let mut p = build(&m.name, &m.options).map_err(fail)?;
-        p.fit(&train_tr).map_err(fail)?;
+        // as `protocol::run` fits: told the training segments' groups (users, vehicles)
+        let p = protocol::build_and_fit(m, &train_tr, &groups).map_err(fail)?;
         let fit_seconds = t0.elapsed().as_secs_f64();
         progress.finish();
         methods.push(MethodParams {

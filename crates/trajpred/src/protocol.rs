@@ -400,7 +400,7 @@ pub type Fitter<'a> =
 
 /// Builds the method and fits it, telling it the training segments' groups
 /// ([`Predictor::fit_grouped`]): what [`run`] and [`cross_validate`] do.
-fn build_and_fit(
+pub(crate) fn build_and_fit(
     m: &MethodSpec,
     train: &[Trajectory],
     groups: &[usize],

@@ -4,7 +4,7 @@
 
 use serde_json::{Value, json};
 use trajpred::dataset::{Dataset, Segment, Segmentation};
-use trajpred::harness::Split;
+use trajpred::harness::{self, Split};
 use trajpred::params::{
     self, MAX_GSC_SIZE, MAX_METHODS, MAX_PARAMS_BYTES, ParamsError, ParamsFile,
 };
@@ -27,6 +27,8 @@ const METHODS: &[&str] = &[
     "poly2",
     "pf",
     "mkpf",
+    "aligned-ridge",
+    "auto",
 ];
 
 /// Segment `i`: 60 points at irregular times, a curve of its own.
@@ -60,6 +62,12 @@ fn options() -> MethodOptions {
         window: 4,
         horizons: 3,
         seed: 5,
+        // the held-out scoring of the methods that choose by cross-validation
+        eval: harness::EvalConfig {
+            history: 10,
+            horizon: 3,
+            ..harness::EvalConfig::default()
+        },
         ..MethodOptions::default()
     }
 }
@@ -115,6 +123,7 @@ fn loaded_parameters_forecast_bit_for_bit_as_the_fitted_methods() {
     let p = protocol_of(METHODS);
     let segs = segments();
     let (train, test) = protocol::split(&p, &segs).expect("split");
+    let groups = harness::group_ids(&train);
     let train: Vec<Trajectory> = train.into_iter().map(|s| s.trajectory).collect();
     let file = reload(&fitted_file(METHODS));
     assert_eq!(file.fitted_on.train_segments, train.len());
@@ -122,12 +131,22 @@ fn loaded_parameters_forecast_bit_for_bit_as_the_fitted_methods() {
     for name in METHODS {
         // the method fitted directly on the training part of the same split
         let mut fitted = build(name, &options()).expect("build");
-        fitted.fit(&train).expect("fit");
+        fitted.fit_grouped(&train, &groups).expect("fit");
         let loaded = file.predictor(name).expect("loads");
         let learns = !file.method(name).expect("saved").params.is_null();
         assert_eq!(
             learns,
-            ["kf-cv", "kf-ca", "gsc", "gskf", "hmm", "imm"].contains(name),
+            [
+                "kf-cv",
+                "kf-ca",
+                "gsc",
+                "gskf",
+                "hmm",
+                "imm",
+                "aligned-ridge",
+                "auto"
+            ]
+            .contains(name),
             "{name}"
         );
         let mut compared = 0;
@@ -525,4 +544,49 @@ fn saving_writes_the_file_whole_and_loading_reads_it_back() {
     // a save into a folder that does not exist is an I/O error naming it
     let bad = dir.path().join("no/such/params.json");
     assert!(matches!(file.save(&bad), Err(ParamsError::Io { .. })));
+}
+
+#[test]
+fn aligned_ridge_and_auto_name_what_does_not_fit_their_options() {
+    let file = fitted_file(&["aligned-ridge", "auto"]);
+    let mut v: Value = serde_json::from_slice(&file.to_json().expect("json")).expect("json");
+    let saved = |v: &Value, i: usize| v["methods"][i]["params"].clone();
+    // aligned-ridge: the shape it was fitted for must be this predictor's
+    let mut ridge = build("aligned-ridge", &options()).expect("build");
+    let mut edited = saved(&v, 0);
+    edited["lags"] = json!(5);
+    match ridge.load_fitted_params(&edited) {
+        Err(Error::InvalidFitted { path, reason, .. }) => {
+            assert_eq!(path, "lags");
+            assert!(reason.contains("fitted with lags 5"), "{reason}");
+        }
+        other => panic!("expected InvalidFitted, got {other:?}"),
+    }
+    let mut edited = saved(&v, 0);
+    edited["weights"][2][1][0] = json!("inf");
+    match ridge.load_fitted_params(&edited) {
+        Err(Error::InvalidFitted { path, .. }) => assert_eq!(path, "weights[2][1][0]"),
+        other => panic!("expected InvalidFitted, got {other:?}"),
+    }
+    assert!(ridge.load_fitted_params(&saved(&v, 0)).is_ok());
+    // auto: the method must be one of its candidates, and the inner path is prefixed
+    let mut auto = build("auto", &options()).expect("build");
+    let mut edited = saved(&v, 1);
+    edited["method"] = json!("lstm");
+    match auto.load_fitted_params(&edited) {
+        Err(Error::InvalidFitted { path, reason, .. }) => {
+            assert_eq!(path, "method");
+            assert!(reason.contains("not among"), "{reason}");
+        }
+        other => panic!("expected InvalidFitted, got {other:?}"),
+    }
+    v["methods"][1]["params"]["method"] = json!("gsc");
+    v["methods"][1]["params"]["params"] = json!({"axes": "x"});
+    match auto.load_fitted_params(&saved(&v, 1)) {
+        Err(Error::InvalidFitted { method, path, .. }) => {
+            assert_eq!(method, "auto");
+            assert_eq!(path, "params.axes");
+        }
+        other => panic!("expected InvalidFitted, got {other:?}"),
+    }
 }

@@ -2,6 +2,7 @@
 //! time-normalised frame (issue 27, idea b).
 
 use super::auto::{fold_of_trajectories, fold_split};
+use super::fitted::{At, exact, exact_matrix, exact_vec};
 use super::invalid;
 use crate::harness::{self, EvalConfig};
 use nalgebra::DMatrix;
@@ -524,6 +525,60 @@ impl Predictor for AlignedRidge {
 
     fn min_history(&self) -> usize {
         self.params.lags + 1
+    }
+
+    /// `{"lags", "horizons", "speed_bins"}` (the shape the weights were fitted for, checked
+    /// against this predictor's parameters on loading), `"lambda"` and `"weights"`: per
+    /// speed regime and step, the `(2 lags + 4) x 2` matrix, row by row.
+    fn fitted_params(&self) -> Result<serde_json::Value> {
+        let Some((lambda, _)) = &self.chosen else {
+            return Err(Error::NotFitted {
+                method: "aligned-ridge".into(),
+            });
+        };
+        let p = &self.params;
+        Ok(serde_json::json!({
+            "lags": p.lags,
+            "horizons": p.horizons,
+            "speed_bins": exact_vec(&p.speed_bins),
+            "lambda": exact(*lambda),
+            "weights": self.weights.iter().map(exact_matrix).collect::<Vec<_>>(),
+        }))
+    }
+
+    fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
+        let root = At::root("aligned-ridge", params);
+        let [lags, horizons, bins, lambda, weights] =
+            root.fields(["lags", "horizons", "speed_bins", "lambda", "weights"])?;
+        let p = &self.params;
+        let same = |at: &At, saved: f64, ours: usize, option: &str| {
+            if saved == ours as f64 {
+                Ok(())
+            } else {
+                Err(at.error(format!(
+                    "fitted with {option} {saved}, but this predictor has {option} {ours}"
+                )))
+            }
+        };
+        same(&lags, lags.f64()?, p.lags, "lags")?;
+        same(&horizons, horizons.f64()?, p.horizons, "horizons")?;
+        let saved_bins = bins.vector(p.speed_bins.len(), At::f64)?;
+        if saved_bins.as_slice() != p.speed_bins.as_slice() {
+            return Err(bins.error(format!(
+                "fitted with speed bins {:?}, but this predictor has {:?}",
+                saved_bins.as_slice(),
+                p.speed_bins
+            )));
+        }
+        let lambda = lambda.f64_min(0.0, false)?;
+        let weights = weights
+            .items(Some(p.models()), p.models())?
+            .iter()
+            .map(|w| w.matrix(p.features(), 2))
+            .collect::<Result<Vec<_>>>()?;
+        self.weights = weights;
+        self.chosen = Some((lambda, Vec::new()));
+        Ok(())
     }
 
     fn fitted_summary(&self) -> Option<String> {

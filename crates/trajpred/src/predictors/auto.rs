@@ -1,6 +1,7 @@
 //! `auto`: the method chosen per dataset by cross-validation by group on the training part
 //! only (issue 27, "model selection without peeking").
 
+use super::fitted::At;
 use super::invalid;
 use crate::harness::{self, EvalConfig};
 use crate::registry::{self, MethodOptions};
@@ -326,8 +327,53 @@ impl Predictor for Auto {
         self.chosen.as_ref().map_or(1, |(_, p)| p.min_history())
     }
 
+    /// `{"method": <the chosen method>, "params": <its fitted parameters>}`: what `auto`
+    /// chose and what that method learned (the cross-validation scores are not saved).
+    fn fitted_params(&self) -> Result<serde_json::Value> {
+        let (name, p) = self.chosen.as_ref().ok_or_else(|| Error::NotFitted {
+            method: "auto".into(),
+        })?;
+        Ok(serde_json::json!({ "method": name, "params": p.fitted_params()? }))
+    }
+
+    fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
+        let root = At::root("auto", params);
+        let [method, inner] = root.fields(["method", "params"])?;
+        let name = method.str()?;
+        if !self.params.candidates.iter().any(|c| c == name) {
+            return Err(method.error(format!(
+                "`{name}` is not among this auto's candidates {:?}",
+                self.params.candidates
+            )));
+        }
+        let mut p = registry::build(name, &self.options)?;
+        p.load_fitted_params(inner.value()).map_err(|e| match e {
+            Error::InvalidFitted {
+                method: m,
+                path,
+                reason,
+            } => Error::InvalidFitted {
+                method: "auto".into(),
+                path: if path.is_empty() {
+                    "params".into()
+                } else {
+                    format!("params.{path}")
+                },
+                reason: format!("{m}: {reason}"),
+            },
+            other => other,
+        })?;
+        self.chosen = Some((name.to_string(), p));
+        self.scores.clear();
+        self.folds_used = 0;
+        Ok(())
+    }
+
     fn fitted_summary(&self) -> Option<String> {
         let chosen = self.chosen()?;
+        if self.scores.is_empty() {
+            return Some(format!("{chosen}, loaded from saved parameters"));
+        }
         let mut s = format!(
             "chose {chosen} by {}-fold cross-validation by group (mean error, m, per fold):",
             self.folds_used

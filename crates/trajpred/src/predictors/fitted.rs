@@ -112,6 +112,18 @@ impl<'a> At<'a> {
             .collect())
     }
 
+    /// The JSON value itself.
+    pub(crate) fn value(&self) -> &'a Value {
+        self.value
+    }
+
+    /// A string.
+    pub(crate) fn str(&self) -> Result<&'a str> {
+        self.value
+            .as_str()
+            .ok_or_else(|| self.error("expected a string"))
+    }
+
     /// A finite number (an exact string or a JSON number).
     pub(crate) fn f64(&self) -> Result<f64> {
         let v = match self.value {
