@@ -4,6 +4,7 @@
 //! ```text
 //! cargo xtask reproduce [--paper <slug>|all] [--quick] [--check | --bless]
 //!                       [--data DIR] [--out DIR] [--seed N] [--jobs N]
+//! cargo xtask perf [--runs N] [--out DIR] [--table-only]
 //! ```
 //!
 //! The slugs are those of `trajpred_repro::Paper::ALL`. A run is written to `--out`
@@ -75,6 +76,20 @@ enum Command {
         #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
         jobs: Option<u64>,
     },
+    /// One sitting of every speed comparison (ours beside the peer: scikit-learn, adskalman,
+    /// filterpy, PyTorch), then the table of docs/performance.md rewritten from it. Run it on
+    /// an otherwise idle machine; it takes about 15 minutes.
+    Perf {
+        /// Rounds of the alternating comparisons (LAR, neural).
+        #[arg(long, default_value_t = 5)]
+        runs: u32,
+        /// Where the sitting's raw outputs go.
+        #[arg(long, default_value = "target/perf-sitting")]
+        out: PathBuf,
+        /// Only rewrite the table from the outputs already in --out.
+        #[arg(long)]
+        table_only: bool,
+    },
 }
 
 /// The workspace root (xtask lives one level below it).
@@ -118,8 +133,42 @@ fn under(root: &Path, path: PathBuf) -> PathBuf {
     }
 }
 
+/// Runs a program from the workspace root, failing when it does.
+fn run(root: &Path, program: &str, args: &[&str]) -> Result<()> {
+    let status = std::process::Command::new(program)
+        .args(args)
+        .current_dir(root)
+        .status()
+        .with_context(|| format!("starting {program}"))?;
+    if !status.success() {
+        bail!("{program} {} failed: {status}", args.join(" "));
+    }
+    Ok(())
+}
+
 fn main() -> Result<()> {
     match Cli::parse().command {
+        Command::Perf {
+            runs,
+            out,
+            table_only,
+        } => {
+            let root = root();
+            let out = under(&root, out);
+            let out = out.to_string_lossy();
+            if !table_only {
+                run(
+                    &root,
+                    "bash",
+                    &["xtask/perf/sitting.sh", &out, &runs.to_string()],
+                )?;
+            }
+            run(
+                &root,
+                "python3",
+                &["xtask/perf/table.py", &out, "docs/performance.md"],
+            )
+        }
         Command::Reproduce {
             paper,
             quick,

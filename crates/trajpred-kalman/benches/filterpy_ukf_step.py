@@ -2,8 +2,11 @@
 (5-state coordinated turn, range-bearing observation, Merwe points alpha=0.5, beta=2,
 kappa=-2), so the Rust figure can be set beside it in the same session.
 
-Run:  /work/venv/bin/python crates/trajpred-kalman/benches/filterpy_ukf_step.py
+Run:  <venv>/bin/python crates/trajpred-kalman/benches/filterpy_ukf_step.py
+Prints the median per step over 15 batches of 2000 steps, with the min..max of the batches,
+and the same as one JSON line.
 """
+import json
 import math
 import timeit
 
@@ -54,10 +57,15 @@ def main():
         ukf.predict()
         ukf.update(z)
 
-    n = 2000
-    best = min(timeit.repeat(step, number=n, repeat=5)) / n
+    n, repeat = 2000, 15
+    per_step = sorted(t / n for t in timeit.repeat(step, number=n, repeat=repeat))
+    median = per_step[len(per_step) // 2]
     print(f"filterpy {filterpy.__version__} UKF predict+update (CT 5-state, range-bearing): "
-          f"{best * 1e6:.1f} us per step (best of 5 x {n})")
+          f"median {median * 1e6:.2f} us per step [min {per_step[0] * 1e6:.2f} .. max "
+          f"{per_step[-1] * 1e6:.2f}] over {repeat} batches of {n}")
+    print(json.dumps({"impl": "filterpy", "workload": "ukf_step", "version": filterpy.__version__,
+                      "median_s": median, "min_s": per_step[0], "max_s": per_step[-1],
+                      "batches": repeat, "steps_per_batch": n}))
 
 
 if __name__ == "__main__":
