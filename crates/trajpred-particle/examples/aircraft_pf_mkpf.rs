@@ -10,9 +10,10 @@
 //!
 //! Prints the position RMSE of the raw observations and of each filter, and each filter's
 //! 10-step-ahead error. `tests/examples_run.rs` runs it. What it shows (seeds 1, 2, 3, 7): the
-//! bootstrap filter at 21-31 m against the observations' 38-46 m, and the MKPF with its
-//! default settings (`ParticlePrior::Carried`, the paper's reading) at 89-120 m, worse than
-//! the raw observations; `docs/particle.md` ("An open finding") says why we think so.
+//! bootstrap filter at 23-31 m against the observations' 38-46 m, and the MKPF with its
+//! default settings (`ParticlePrior::ProposalMean`, the paper's Algorithm 1 read literally) at
+//! 39-50 m, about the raw observations; `docs/particle.md` ("The MKPF on a slowly turning
+//! aircraft") compares the three particle priors.
 #![allow(clippy::print_stdout)]
 
 use rand_distr::{Distribution, StandardNormal};

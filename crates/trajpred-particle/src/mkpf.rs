@@ -45,18 +45,24 @@ pub enum EkfStage {
 /// the particle's "mean and covariance" open; see `docs/particle.md`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum ParticlePrior {
-    /// Default: the paper's Algorithm 1 (van der Merwe's unscented particle filter). The UKF
-    /// step starts from `N(x_(k-1)^i, P_(k-1)^i)`, `P_(k-1)^i` the particle's previous
-    /// proposal covariance (`P_0` at the start). When `Q` is small against `P^i` in the
-    /// directions the observation does not fix, the proposal is much wider than the
-    /// transition density of eq. 9 and the weights degenerate (see `docs/particle.md`).
-    #[default]
+    /// The UKF step starts from `N(x_(k-1)^i, P_(k-1)^i)`: the particle's *drawn* state with
+    /// its previous proposal covariance (`P_0` at the start). The spread of the draw is then
+    /// counted twice (once in the drawn state, once in `P`), the proposal is wider than the
+    /// transition density of eq. 9, and the weights degenerate when `Q` is small against
+    /// `P^i` in the directions the observation does not fix (see `docs/particle.md`).
     Carried,
     /// The UKF step conditions on the particle: its prediction is exactly
     /// `N(f(x_(k-1)^i), Q)` (the unscented transform of a point mass), so the UKF+EKF update
     /// approximates the optimal proposal `p(x_k | x_(k-1)^i, z_k)`. The covariance each
     /// particle carries is then its last proposal covariance, reported but not fed back.
     Conditioned,
+    /// Default: the paper's Algorithm 1 read literally, as van der Merwe's unscented particle
+    /// filter keeps them: every particle carries a mean and a covariance, and its UKF step
+    /// starts from `N(x̄_(k-1)^i, P_(k-1)^i)`, its previous proposal's mean and covariance
+    /// (`x̄_0^i` the particle itself, `P_0^i = P_0`). The drawn state `x_(k-1)^i` enters only
+    /// the transition density of eq. 9.
+    #[default]
+    ProposalMean,
 }
 
 /// Which UKF of the Kalman crate runs the UKF stage of the proposal.
@@ -64,7 +70,8 @@ pub enum ParticlePrior {
 pub enum UkfVariant {
     /// Default: the augmented UKF of the paper (eq. 12-19, `trajpred_kalman::AugmentedUkf`):
     /// sigma points of `N([x; 0; 0], blockdiag(P, Q, R))`, propagated through `f(x, w)` and
-    /// `h(f(x, w), v)`, the update from the same points. Used with [`ParticlePrior::Carried`];
+    /// `h(f(x, w), v)`, the update from the same points. Used with [`ParticlePrior::Carried`]
+    /// and [`ParticlePrior::ProposalMean`];
     /// with [`ParticlePrior::Conditioned`] the prior covariance is zero, so the update is the
     /// additive one.
     #[default]
@@ -199,6 +206,8 @@ where
     ukf_variant: UkfVariant,
     cloud: ParticleCloud<T, D>,
     covariances: Vec<OMatrix<T, D, D>>,
+    /// Each particle's last proposal mean (used by [`ParticlePrior::ProposalMean`]).
+    means: Vec<OVector<T, D>>,
     config: PfConfig,
     q_factor: OMatrix<T, D, D>,
     transition_density: Density<T, D>,
@@ -213,6 +222,8 @@ where
 {
     x: OVector<T, D>,
     p: OMatrix<T, D, D>,
+    /// The proposal mean (the drawn state when there was no proposal).
+    m: OVector<T, D>,
     log_increment: f64,
     fallback: bool,
 }
@@ -263,6 +274,7 @@ where
         let transition_density = Density::new(transition.process_noise(), "Q")?;
         let likelihood = Density::new(observation.observation_noise(), "R")?;
         let covariances = vec![initial_covariance; cloud.len()];
+        let means = cloud.particles().to_vec();
         Ok(Mkpf {
             transition,
             observation,
@@ -272,6 +284,7 @@ where
             ukf_variant: UkfVariant::default(),
             cloud,
             covariances,
+            means,
             config: PfConfig::default(),
             q_factor,
             transition_density,
@@ -339,11 +352,9 @@ where
     fn ukf_stage(&self) -> Result<UkfStage<'_, T, Tr, Ob>> {
         let additive = Ukf::new(&self.transition, &self.observation, self.points)?;
         let augmented = match (self.ukf_variant, self.prior_mode) {
-            (UkfVariant::Augmented, ParticlePrior::Carried) => Some(AugmentedUkf::new(
-                &self.transition,
-                &self.observation,
-                self.points,
-            )?),
+            (UkfVariant::Augmented, ParticlePrior::Carried | ParticlePrior::ProposalMean) => Some(
+                AugmentedUkf::new(&self.transition, &self.observation, self.points)?,
+            ),
             _ => None,
         };
         Ok(UkfStage {
@@ -370,7 +381,8 @@ where
     /// The same filter (particles, weights, observation, settings) with another transition,
     /// e.g. the model of another time step. Every particle then carries the mean of the
     /// particles' covariances (a new `Q` changes what each particle's covariance means; their
-    /// mean is the cloud's own uncertainty estimate).
+    /// mean is the cloud's own uncertainty estimate); each particle keeps its last proposal
+    /// mean ([`ParticlePrior::ProposalMean`]).
     pub fn with_transition(&self, transition: Tr) -> Result<Self>
     where
         Ob: Clone,
@@ -381,7 +393,7 @@ where
             OMatrix::<T, D, D>::zeros_generic(D::from_usize(n), D::from_usize(n)),
             |a, c| a + c,
         ) / nalgebra::convert::<f64, T>(covs.len().max(1) as f64);
-        Ok(Self::new(
+        let mut rebuilt = Self::new(
             transition,
             self.observation.clone(),
             self.cloud.clone(),
@@ -391,7 +403,10 @@ where
         .with_config(self.config)?
         .with_ekf_stage(self.stage)
         .with_particle_prior(self.prior_mode)
-        .with_ukf_variant(self.ukf_variant))
+        .with_ukf_variant(self.ukf_variant);
+        // the particles' proposal means are states, whatever the model
+        rebuilt.means.clone_from(&self.means);
+        Ok(rebuilt)
     }
 
     /// The UKF prediction of one particle by [`ParticlePrior`].
@@ -401,7 +416,7 @@ where
         prior: &Gaussian<T, D>,
     ) -> trajpred_kalman::Result<Gaussian<T, D>> {
         match self.prior_mode {
-            ParticlePrior::Carried => match &ukf.augmented {
+            ParticlePrior::Carried | ParticlePrior::ProposalMean => match &ukf.augmented {
                 Some(a) => a.predict(prior),
                 None => ukf.additive.predict(prior),
             },
@@ -420,7 +435,7 @@ where
         z: &OVector<T, M>,
     ) -> trajpred_kalman::Result<(Gaussian<T, D>, Gaussian<T, D>)> {
         let (pred, ukf_post) = match (&ukf.augmented, self.prior_mode) {
-            (Some(a), ParticlePrior::Carried) => {
+            (Some(a), ParticlePrior::Carried | ParticlePrior::ProposalMean) => {
                 let step = a.step(prior, Some(z))?;
                 let post = step.posterior().clone();
                 (step.prior, post)
@@ -451,38 +466,45 @@ where
         Ok((pred, q))
     }
 
-    /// One particle's move: the proposal draw and its weight increment (eq. 9), or the
-    /// fallback to the transition prior.
+    /// One particle's move (its drawn state `x`, last proposal mean `m` and covariance `p`):
+    /// the proposal draw and its weight increment (eq. 9), or the fallback to the transition
+    /// prior.
     fn move_particle(
         &self,
         ukf: &UkfStage<'_, T, Tr, Ob>,
         x: &OVector<T, D>,
+        m: &OVector<T, D>,
         p: &OMatrix<T, D, D>,
         e: &[T],
         z: Option<&OVector<T, M>>,
     ) -> Result<Moved<T, D>> {
         let prior = Gaussian {
-            mean: x.clone(),
+            mean: match self.prior_mode {
+                ParticlePrior::ProposalMean => m.clone(),
+                ParticlePrior::Carried | ParticlePrior::Conditioned => x.clone(),
+            },
             covariance: p.clone(),
         };
         let Some(z) = z else {
             let xn = propagate_one(&self.transition, &self.q_factor, x, e)?;
-            let pn = self
+            let (mn, pn) = self
                 .ukf_prediction(ukf, &prior)
-                .map_or_else(|_| p.clone(), |g| g.covariance);
+                .map_or_else(|_| (xn.clone(), p.clone()), |g| (g.mean, g.covariance));
             return Ok(Moved {
                 x: xn,
                 p: pn,
+                m: mn,
                 log_increment: 0.0,
                 fallback: false,
             });
         };
-        match self.propose(ukf, &prior, z, e) {
+        match self.propose(ukf, x, &prior, z, e) {
             Ok(Some(m)) => Ok(m),
             Ok(None) | Err(_) => {
                 let xn = propagate_one(&self.transition, &self.q_factor, x, e)?;
                 let ll = log_likelihood(&self.observation, &self.likelihood, &xn, z)?;
                 Ok(Moved {
+                    m: xn.clone(),
                     x: xn,
                     p: p.clone(),
                     log_increment: ll,
@@ -492,10 +514,12 @@ where
         }
     }
 
-    /// The MKPF proposal draw; `Ok(None)` or `Err` asks for the fallback.
+    /// The MKPF proposal draw for the particle at `x` whose UKF starts from `prior`;
+    /// `Ok(None)` or `Err` asks for the fallback.
     fn propose(
         &self,
         ukf: &UkfStage<'_, T, Tr, Ob>,
+        x: &OVector<T, D>,
         prior: &Gaussian<T, D>,
         z: &OVector<T, M>,
         e: &[T],
@@ -513,7 +537,7 @@ where
         let e2: f64 = e.iter().map(|v| to_f64(*v) * to_f64(*v)).sum();
         let n = e.len() as f64;
         let log_q = -0.5 * (n * (2.0 * std::f64::consts::PI).ln() + e2) - log_det_half(&chol);
-        let fx = self.transition.transition(&prior.mean)?;
+        let fx = self.transition.transition(x)?;
         let log_trans = self
             .transition_density
             .log_density(&self.transition.state_residual(&xn, &fx));
@@ -527,6 +551,7 @@ where
         Ok(Some(Moved {
             x: xn,
             p: q.covariance,
+            m: q.mean,
             log_increment: inc,
             fallback: false,
         }))
@@ -557,10 +582,11 @@ where
             .cloud
             .particles()
             .par_iter()
+            .zip(this.means.par_iter())
             .zip(this.covariances.par_iter())
             .zip(noise.par_chunks(n))
             .with_min_len((MIN_PARTICLES_PER_TASK / 64).max(1))
-            .map(|((x, p), e)| this.move_particle(&ukf, x, p, e, z))
+            .map(|(((x, m), p), e)| this.move_particle(&ukf, x, m, p, e, z))
             .collect::<Result<_>>()?;
         let mut log_w: Vec<f64> = this
             .cloud
@@ -571,11 +597,20 @@ where
             .collect();
         let (select, ess, lse) = weigh_and_select(&mut log_w, &self.config, rng)?;
         let fallbacks = moved.iter().filter(|m| m.fallback).count();
-        let (particles, mut covs): (Vec<_>, Vec<_>) = moved.into_iter().map(|m| (m.x, m.p)).unzip();
+        let mut particles = Vec::with_capacity(moved.len());
+        let mut covs = Vec::with_capacity(moved.len());
+        let mut means = Vec::with_capacity(moved.len());
+        for m in moved {
+            particles.push(m.x);
+            covs.push(m.p);
+            means.push(m.m);
+        }
         if let Some(idx) = &select {
             covs = idx.iter().map(|&i| covs[i].clone()).collect();
+            means = idx.iter().map(|&i| means[i].clone()).collect();
         }
         self.covariances = covs;
+        self.means = means;
         finish_step(
             &mut self.cloud,
             particles,

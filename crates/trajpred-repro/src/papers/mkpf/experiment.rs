@@ -47,11 +47,12 @@ impl Motion {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Method {
     /// The MKPF (per particle a UKF step then an EKF step give the proposal; eq. 9 weights;
-    /// residual resampling every step), with this many particles.
+    /// residual resampling every step; the UKF from the particle's last proposal mean and
+    /// covariance, `ParticlePrior::ProposalMean`), with this many particles.
     Mkpf(usize),
     /// The MKPF with the crate's `ParticlePrior::Conditioned` (each particle's UKF step
     /// starts from its own transition `N(f(x), Q)`, approximating the optimal proposal)
-    /// instead of the carried covariance of the paper's Algorithm 1.
+    /// instead of the last proposal's mean and covariance (the paper's Algorithm 1).
     MkpfConditioned(usize),
     /// The bootstrap particle filter (transition prior as proposal; residual resampling every
     /// step), with this many particles.
@@ -288,7 +289,7 @@ where
         Method::Mkpf(particles) | Method::MkpfConditioned(particles) => {
             let prior = match method {
                 Method::MkpfConditioned(_) => ParticlePrior::Conditioned,
-                _ => ParticlePrior::Carried,
+                _ => ParticlePrior::ProposalMean,
             };
             let mkpf = Mkpf::<f64, D, U2, Tr, LinearObservation<f64, D, U2>>::from_gaussian(
                 make(first_dt)?,
