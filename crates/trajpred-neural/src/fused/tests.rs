@@ -456,3 +456,27 @@ fn plain_weights_with_autodiff_data_run_fused() {
         );
     }
 }
+
+/// The gates' `exp` ([`super::exp_f32`]) is within 1 ulp of the standard library's on
+/// `[-87, 88]`, clamps outside it (staying finite and positive), and keeps NaN.
+#[test]
+fn exp_f32_matches_the_standard_library() {
+    let ulp = |v: f32| f32::from_bits(v.to_bits() + 1) - v;
+    let mut worst = 0f32;
+    let mut x = -87.0f32;
+    while x <= 88.0 {
+        let (fast, exact) = (super::exp_f32(x), x.exp());
+        worst = worst.max((fast - exact).abs() / ulp(exact));
+        x += 0.001_3;
+    }
+    for x in [0.0f32, 1e-8, -1e-8, 0.5, -0.5, 1.0, -1.0, 20.0, -20.0] {
+        let (fast, exact) = (super::exp_f32(x), x.exp());
+        worst = worst.max((fast - exact).abs() / ulp(exact));
+    }
+    assert!(worst <= 1.0, "max error {worst} ulp");
+    assert_eq!(super::exp_f32(-1e4), super::exp_f32(-87.0));
+    assert_eq!(super::exp_f32(1e4), super::exp_f32(88.0));
+    assert!(super::exp_f32(f32::INFINITY).is_finite());
+    assert!(super::exp_f32(f32::NEG_INFINITY) > 0.0);
+    assert!(super::exp_f32(f32::NAN).is_nan());
+}
