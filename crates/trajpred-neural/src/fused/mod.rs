@@ -18,6 +18,7 @@
 //! (`TrainConfig::fused = false`); the tests in `fused/tests.rs` hold every gradient of
 //! both ops to it.
 
+pub(crate) mod adam;
 pub(crate) mod bridge;
 pub(crate) mod kfu;
 pub(crate) mod lstm;
@@ -72,7 +73,7 @@ pub(crate) fn exp_f32(x: f32) -> f32 {
     let p = p * r + 8.333_452e-3;
     let p = p * r + 4.166_579_6e-2;
     let p = p * r + 1.666_666_5e-1;
-    let p = p * r + 5.000_000_1e-1;
+    let p = p * r + 0.5;
     let e = p * r * r + r + 1.0;
     // `shifted`'s bits are ROUND's plus `n` (its unit in the last place is 1 there)
     let scale = f32::from_bits(

@@ -4,13 +4,14 @@
 //! magnitude of that gradient (f32); the backward passes equal central finite differences
 //! of the forward passes in f64; and the outputs agree within `1e-5` (f32).
 
-use super::{kfu, lstm};
+use super::{adam, kfu, lstm};
 use crate::arch::{Architecture, FusedLstm, LstmArch, RecurrentLayers};
 use crate::config::{Activation, TrainConfig};
 use crate::kfu::{KfuCell, KfuConfig};
 use crate::train::{device, read, rng};
+use burn::grad_clipping::GradientClippingConfig;
 use burn::module::{Module, ModuleMapper, ModuleVisitor, Param};
-use burn::optim::GradientsParams;
+use burn::optim::{GradientsParams, ModuleOptimizer};
 use burn::tensor::{Device, Tensor, TensorData};
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
@@ -479,4 +480,67 @@ fn exp_f32_matches_the_standard_library() {
     assert!(super::exp_f32(f32::INFINITY).is_finite());
     assert!(super::exp_f32(f32::NEG_INFINITY) > 0.0);
     assert!(super::exp_f32(f32::NAN).is_nan());
+}
+
+/// Collects the values of every parameter, in visiting order.
+struct Values(Vec<Vec<f32>>);
+
+impl ModuleVisitor for Values {
+    fn visit_float<const D: usize>(&mut self, param: &Param<Tensor<D>>) {
+        self.0.push(read(param.val()).unwrap_or_default());
+    }
+}
+
+/// [`adam::FusedAdam`] updates every parameter bit for bit as burn's `Adam` of the same
+/// configuration: five steps on an LSTM network (every parameter shape of the models),
+/// with and without gradient clipping, first step included.
+#[test]
+fn fused_adam_equals_burns_adam_bit_for_bit() {
+    let device = device();
+    for (seed, clip) in [(0u64, None), (1, Some(0.05f32))] {
+        let mut r = rng(seed, 13);
+        let arch = LstmArch(RecurrentLayers {
+            layers: vec![5, 4],
+            fc: vec![3],
+            activation: Activation::Relu,
+        });
+        let net = arch.build(2, 4, 3, &device).map(&mut Fill {
+            rng: &mut r,
+            scale: 0.5,
+        });
+        let optimizer = |fused: bool| {
+            let o = if fused {
+                ModuleOptimizer::from(adam::FusedAdam::new(1e-8))
+            } else {
+                adam::FusedAdam::config(1e-8).init()
+            };
+            match clip {
+                Some(c) => o.with_grad_clipping(GradientClippingConfig::Norm(c).init()),
+                None => o,
+            }
+        };
+        let mut nets = [net.clone(), net];
+        let mut optims = [optimizer(true), optimizer(false)];
+        for step in 0..5 {
+            let x = tensor(uniform(&mut r, 3 * 4 * 2, 1.5), [3, 4, 2], &device);
+            for (n, o) in nets.iter_mut().zip(&mut optims) {
+                let y = arch.forward(n, x.clone());
+                let grads = GradientsParams::from_grads((y.clone() * y).sum().backward(), n);
+                *n = o.step(1e-2, n.clone(), grads);
+            }
+            let [fused, reference] = nets.each_ref().map(|n| {
+                let mut v = Values(Vec::new());
+                n.visit(&mut v);
+                v.0
+            });
+            assert_eq!(fused.len(), reference.len());
+            for (k, (a, b)) in fused.iter().zip(&reference).enumerate() {
+                let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert!(
+                    !a.is_empty() && bits(a) == bits(b),
+                    "seed {seed} clip {clip:?} step {step}: parameter {k} differs"
+                );
+            }
+        }
+    }
 }
