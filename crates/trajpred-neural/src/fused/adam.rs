@@ -13,6 +13,7 @@ use burn::backend::Flex;
 use burn::backend::flex::FlexTensor;
 use burn::optim::{Adam, AdamConfig, AdamState, AdaptiveMomentumState, LearningRate, Optimizer};
 use burn::tensor::{DType, Device, Tensor};
+use std::ops::Range;
 
 /// `beta_1` of burn's `AdamConfig` default, which the training loop uses.
 const BETA_1: f32 = 0.9;
@@ -53,17 +54,18 @@ fn whole(t: &FlexTensor, n: usize) -> bool {
         && t.storage::<f32>().len() == n
 }
 
-/// The primitives of one step: parameter, gradient, and the step count and moments of the
-/// state (none at the first step).
+/// The primitives of one step: parameter, gradient (with the range of its storage that
+/// holds its values), and the step count and moments of the state (none at the first step).
 type Prims = (
     FlexTensor,
-    FlexTensor,
+    (FlexTensor, Range<usize>),
     Option<(usize, FlexTensor, FlexTensor)>,
 );
 
 impl FusedAdam {
-    /// The flex primitives of a step, when every tensor is a whole `f32` flex tensor of the
-    /// parameter's size and the state has no AMSGrad moment; `None` sends the step to burn's
+    /// The flex primitives of a step, when the parameter and the moments are whole `f32`
+    /// flex tensors, the gradient a contiguous one, all of the parameter's size, and the
+    /// state has no AMSGrad moment; `None` sends the step to burn's
     /// `Adam`.
     fn prims<const D: usize>(
         tensor: &Tensor<D>,
@@ -85,12 +87,15 @@ impl FusedAdam {
             Some(_) => return None,
             None => None,
         };
+        // the gradient is only read: a contiguous view (a slice of the packed parameters'
+        // gradient, in the KFU model) will do
+        let (start, end) = g.layout().contiguous_offsets()?;
         let all_whole = whole(&p, n)
-            && whole(&g, n)
+            && end - start == n
             && moments
                 .as_ref()
                 .is_none_or(|(_, a, b)| whole(a, n) && whole(b, n));
-        all_whole.then_some((p, g, moments))
+        all_whole.then_some((p, (g, start..end), moments))
     }
 
     /// One step over the primitives, in burn's order of `f32` operations, updating the
@@ -103,7 +108,8 @@ impl FusedAdam {
         shape: &[usize],
     ) -> (FlexTensor, usize, FlexTensor, FlexTensor) {
         let (mut p, g, moments) = prims;
-        let g = g.storage::<f32>();
+        let (g, range) = g;
+        let g = &g.storage::<f32>()[range];
         let (f1, f2) = (1.0 - BETA_1, 1.0 - BETA_2);
         let (time, m1, m2) = match moments {
             Some((time, mut m1, mut m2)) => {

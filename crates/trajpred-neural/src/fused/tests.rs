@@ -491,9 +491,52 @@ impl ModuleVisitor for Values {
     }
 }
 
+/// Five Adam steps of `fused` and burn's `Adam` from the same module, each on the gradient
+/// of `loss` at its own parameters and input `k`: every parameter stays bit for bit equal.
+fn assert_adam_steps<M: Module>(
+    what: &str,
+    module: M,
+    clip: Option<f32>,
+    loss: impl Fn(&M, u64) -> Tensor<1>,
+) {
+    let optimizer = |fused: bool| {
+        let o = if fused {
+            ModuleOptimizer::from(adam::FusedAdam::new(1e-8))
+        } else {
+            adam::FusedAdam::config(1e-8).init()
+        };
+        match clip {
+            Some(c) => o.with_grad_clipping(GradientClippingConfig::Norm(c).init()),
+            None => o,
+        }
+    };
+    let mut modules = [module.clone(), module];
+    let mut optims = [optimizer(true), optimizer(false)];
+    for step in 0..5 {
+        for (m, o) in modules.iter_mut().zip(&mut optims) {
+            let grads = GradientsParams::from_grads(loss(m, step).backward(), m);
+            *m = o.step(1e-2, m.clone(), grads);
+        }
+        let [fused, reference] = modules.each_ref().map(|m| {
+            let mut v = Values(Vec::new());
+            m.visit(&mut v);
+            v.0
+        });
+        assert_eq!(fused.len(), reference.len());
+        for (k, (a, b)) in fused.iter().zip(&reference).enumerate() {
+            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert!(
+                !a.is_empty() && bits(a) == bits(b),
+                "{what}, clip {clip:?}, step {step}: parameter {k} differs"
+            );
+        }
+    }
+}
+
 /// [`adam::FusedAdam`] updates every parameter bit for bit as burn's `Adam` of the same
-/// configuration: five steps on an LSTM network (every parameter shape of the models),
-/// with and without gradient clipping, first step included.
+/// configuration, first step included, with and without gradient clipping: on an LSTM
+/// network (every parameter shape of the windowed models, whole gradients) and on the fused
+/// KFU filter (gradients that are views into the packed parameters' gradient).
 #[test]
 fn fused_adam_equals_burns_adam_bit_for_bit() {
     let device = device();
@@ -508,39 +551,36 @@ fn fused_adam_equals_burns_adam_bit_for_bit() {
             rng: &mut r,
             scale: 0.5,
         });
-        let optimizer = |fused: bool| {
-            let o = if fused {
-                ModuleOptimizer::from(adam::FusedAdam::new(1e-8))
-            } else {
-                adam::FusedAdam::config(1e-8).init()
-            };
-            match clip {
-                Some(c) => o.with_grad_clipping(GradientClippingConfig::Norm(c).init()),
-                None => o,
-            }
+        let xs: Vec<Tensor<3>> = (0..5)
+            .map(|_| tensor(uniform(&mut r, 3 * 4 * 2, 1.5), [3, 4, 2], &device))
+            .collect();
+        assert_adam_steps("LSTM", net, clip, |n, k| {
+            let y = arch.forward(n, xs[k as usize].clone());
+            (y.clone() * y).sum()
+        });
+        let cfg = KfuConfig {
+            layers: vec![4],
+            fc: vec![3],
+            ..KfuConfig::default()
         };
-        let mut nets = [net.clone(), net];
-        let mut optims = [optimizer(true), optimizer(false)];
-        for step in 0..5 {
-            let x = tensor(uniform(&mut r, 3 * 4 * 2, 1.5), [3, 4, 2], &device);
-            for (n, o) in nets.iter_mut().zip(&mut optims) {
-                let y = arch.forward(n, x.clone());
-                let grads = GradientsParams::from_grads((y.clone() * y).sum().backward(), n);
-                *n = o.step(1e-2, n.clone(), grads);
-            }
-            let [fused, reference] = nets.each_ref().map(|n| {
-                let mut v = Values(Vec::new());
-                n.visit(&mut v);
-                v.0
-            });
-            assert_eq!(fused.len(), reference.len());
-            for (k, (a, b)) in fused.iter().zip(&reference).enumerate() {
-                let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-                assert!(
-                    !a.is_empty() && bits(a) == bits(b),
-                    "seed {seed} clip {clip:?} step {step}: parameter {k} differs"
-                );
-            }
-        }
+        let spec = kfu::Spec {
+            d: 2,
+            layers: cfg.layers.clone(),
+            fc: cfg.fc.clone(),
+            activation: cfg.activation,
+        };
+        let cell = KfuCell::new(&cfg, 2, &device).map(&mut Fill {
+            rng: &mut r,
+            scale: 0.5,
+        });
+        let zs: Vec<Tensor<3>> = (0..5)
+            .map(|_| tensor(uniform(&mut r, 3 * 5 * 2, 1.5), [3, 5, 2], &device))
+            .collect();
+        assert_adam_steps("KFU", cell, clip, |c, k| {
+            let run = c
+                .run_fused(zs[k as usize].clone(), &spec, 1.0, 0)
+                .expect("runs fused");
+            (run.priors.clone() * run.priors).sum()
+        });
     }
 }
