@@ -8,23 +8,29 @@
 //! - [`lstm`]: one LSTM layer over a whole sequence. The input projection of every step is
 //!   one matrix product, the recurrent part runs step by step and keeps the activated
 //!   gates, backpropagation through time is written out, and the weight gradients are one
-//!   matrix product each at the end.
+//!   matrix product each at the end. The windowed model's top layer returns its last step
+//!   only ([`lstm::layer_last`]).
+//! - [`head`]: the windowed LSTM model's fully connected head and its mean squared error
+//!   (the training loss of a batch) as one op.
 //! - [`kfu`]: the whole unrolled Kalman-filter-unfolded LSTM (stacked LSTM transition,
 //!   fully connected head, diagonal Kalman update with learnable `Q`, `R`) over a sequence.
 //!
-//! The arithmetic is generic over `f32`/`f64` ([`Real`]): burn runs it in `f32`, the
-//! finite-difference tests in `f64`. Matrix products go through `ndarray`'s
+//! [`adam`] is the optimizer that goes with them: burn's Adam, bit for bit, in one loop per
+//! parameter. The arithmetic is generic over `f32`/`f64` ([`Real`]): burn runs it in
+//! `f32`, the finite-difference tests in `f64`. Matrix products go through `ndarray`'s
 //! `general_mat_mul` on row-major views. The autodiff-composed models stay as the reference
 //! (`TrainConfig::fused = false`); the tests in `fused/tests.rs` hold every gradient of
-//! both ops to it.
+//! the ops to it.
 
 pub(crate) mod adam;
 pub(crate) mod bridge;
+pub(crate) mod head;
 pub(crate) mod kfu;
 pub(crate) mod lstm;
 #[cfg(test)]
 mod tests;
 
+use crate::config::Activation;
 use crate::error::{NeuralError, Result};
 use ndarray::linalg::general_mat_mul;
 use ndarray::{ArrayView2, ArrayViewMut2};
@@ -164,6 +170,31 @@ pub(crate) fn sigmoid<T: Real>(x: T) -> T {
 pub(crate) fn tanh<T: Real>(x: T) -> T {
     let one = T::one();
     one - (one + one) / ((x + x).exp_gate() + one)
+}
+
+/// Applies the activation of fully connected hidden layers to `v` in place.
+pub(crate) fn activate<T: Real>(a: Activation, v: &mut [T]) {
+    for x in v {
+        *x = match a {
+            Activation::Relu => x.max(T::zero()),
+            Activation::Tanh => tanh(*x),
+            Activation::Sigmoid => sigmoid(*x),
+        };
+    }
+}
+
+/// Multiplies `g` by the activation's derivative, given the activated outputs `y`.
+pub(crate) fn activate_backward<T: Real>(a: Activation, y: &[T], g: &mut [T]) {
+    let one = T::one();
+    for (g, &y) in g.iter_mut().zip(y) {
+        *g = *g
+            * match a {
+                Activation::Relu if y > T::zero() => one,
+                Activation::Relu => T::zero(),
+                Activation::Tanh => one - y * y,
+                Activation::Sigmoid => y * (one - y),
+            };
+    }
 }
 
 /// The four gate blocks `[i f g o]` of one row of `4h` values.

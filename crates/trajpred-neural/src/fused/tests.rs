@@ -4,7 +4,7 @@
 //! magnitude of that gradient (f32); the backward passes equal central finite differences
 //! of the forward passes in f64; and the outputs agree within `1e-5` (f32).
 
-use super::{adam, kfu, lstm};
+use super::{adam, head, kfu, lstm};
 use crate::arch::{Architecture, FusedLstm, LstmArch, RecurrentLayers};
 use crate::config::{Activation, TrainConfig};
 use crate::kfu::{KfuCell, KfuConfig};
@@ -312,7 +312,8 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-/// The LSTM layer's backward pass equals finite differences of its forward pass (f64).
+/// The LSTM layer's backward pass equals finite differences of its forward pass (f64), from
+/// the gradient of every hidden state (even seeds) or of the last step's only (odd seeds).
 #[test]
 fn lstm_backward_equals_finite_differences() {
     for seed in 0..6u64 {
@@ -328,12 +329,23 @@ fn lstm_backward_equals_finite_differences() {
         let w_ih = uniform64(&mut r, d * 4 * h, 0.7);
         let bias = uniform64(&mut r, 4 * h, 0.7);
         let w_hh = uniform64(&mut r, h * 4 * h, 0.7);
-        let w = uniform64(&mut r, b * t * h, 1.0);
-        let (_, cache) = lstm::forward(dims, &x, &w_ih, &bias, &w_hh).expect("shapes");
-        let g = lstm::backward(&cache, &w_ih, &w_hh, &w, true).expect("shapes");
-        let what = format!("seed {seed}: {dims:?}");
+        let last = seed % 2 == 1;
+        let w = uniform64(&mut r, b * if last { 1 } else { t } * h, 1.0);
+        let cache = lstm::forward(dims, &x, &w_ih, &bias, &w_hh).expect("shapes");
+        let dh = if last {
+            lstm::OutGrad::Last(&w)
+        } else {
+            lstm::OutGrad::All(&w)
+        };
+        let g = lstm::backward(&cache, &w_ih, &w_hh, dh, true).expect("shapes");
+        let what = format!("seed {seed}: {dims:?}, last step only: {last}");
         let f = |x: &[f64], wi: &[f64], bb: &[f64], wh: &[f64]| {
-            dot(&lstm::forward(dims, x, wi, bb, wh).expect("shapes").0, &w)
+            let c = lstm::forward(dims, x, wi, bb, wh).expect("shapes");
+            if last {
+                dot(c.last(), &w)
+            } else {
+                dot(&c.output(), &w)
+            }
         };
         check_fd(&format!("{what}: dx"), &x, &g.dx.unwrap_or_default(), |p| {
             f(p, &w_ih, &bias, &w_hh)
@@ -347,6 +359,102 @@ fn lstm_backward_equals_finite_differences() {
         check_fd(&format!("{what}: dW_hh"), &w_hh, &g.dw_hh, |p| {
             f(&x, &w_ih, &bias, p)
         });
+    }
+}
+
+/// The windowed LSTM model's training loss: the fused path (stacked layers, the top one
+/// returning its last step, then the head and the mean squared error as one op) against
+/// burn's autodiff through the composed network and `mse`: the loss, and the gradient of
+/// every parameter, of the input windows and of the targets.
+#[test]
+fn lstm_loss_gradients_equal_the_composed_reference() {
+    let device = device();
+    let acts = [Activation::Relu, Activation::Tanh, Activation::Sigmoid];
+    for seed in 0..12u64 {
+        let mut r = rng(seed, 14);
+        let arch = LstmArch(RecurrentLayers {
+            layers: (0..r.random_range(1..4))
+                .map(|_| r.random_range(1..9))
+                .collect(),
+            fc: (0..r.random_range(0..3))
+                .map(|_| r.random_range(1..6))
+                .collect(),
+            activation: acts[r.random_range(0..3)],
+        });
+        let (b, m, f, out) = (
+            r.random_range(1..6),
+            r.random_range(1..7),
+            r.random_range(1..4),
+            r.random_range(1..5),
+        );
+        let net = arch.build(f, m, out, &device).map(&mut Fill {
+            rng: &mut r,
+            scale: 0.5,
+        });
+        let (xv, yv) = (
+            uniform(&mut r, b * m * f, 1.5),
+            uniform(&mut r, b * out, 1.0),
+        );
+        let what = format!("seed {seed}: {arch:?} B {b} m {m} f {f} out {out}");
+        let mut results = Vec::new();
+        for fused in [true, false] {
+            let net = arch.configure(net.clone(), &TrainConfig::new(1e-3).with_fused(fused));
+            let x = tensor(xv.clone(), [b, m, f], &device).require_grad();
+            let y = tensor(yv.clone(), [b, out], &device).require_grad();
+            let loss = arch.loss(&net, x.clone(), y.clone());
+            let value = read(loss.clone()).expect("f32");
+            let grads = loss.backward();
+            let gx = read(x.grad(&grads).expect("input gradient")).expect("f32");
+            let gy = read(y.grad(&grads).expect("target gradient")).expect("f32");
+            let gp = GradientsParams::from_grads(grads, &net);
+            results.push((value, gx, gy, collect(&gp, &net)));
+        }
+        let (value, gx, gy, gp) = &results[0];
+        let (value_ref, gx_ref, gy_ref, gp_ref) = &results[1];
+        assert_close(value, value_ref, OUT_TOL, &format!("{what}: loss"));
+        assert_close(gx, gx_ref, GRAD_TOL, &format!("{what}: dx"));
+        assert_close(gy, gy_ref, GRAD_TOL, &format!("{what}: dy"));
+        assert_eq!(gp.len(), gp_ref.len());
+        for (k, (a, e)) in gp.iter().zip(gp_ref).enumerate() {
+            assert_param(a, e, &format!("{what}: parameter {k}"));
+        }
+    }
+}
+
+/// The fused head's backward pass equals finite differences of its loss (f64), for the
+/// input, every packed parameter and the targets.
+#[test]
+fn head_backward_equals_finite_differences() {
+    let acts = [Activation::Relu, Activation::Tanh, Activation::Sigmoid];
+    for seed in 0..6u64 {
+        let mut r = rng(seed, 15);
+        let spec = head::Spec {
+            input: r.random_range(1..5),
+            fc: (0..r.random_range(0..3))
+                .map(|_| r.random_range(1..5))
+                .collect(),
+            output: r.random_range(1..4),
+            activation: acts[(seed % 3) as usize],
+        };
+        let batch = r.random_range(1..4);
+        let h = uniform64(&mut r, batch * spec.input, 1.5);
+        let params = uniform64(&mut r, spec.n_params(), 0.7);
+        let y = uniform64(&mut r, batch * spec.output, 1.0);
+        let g = 0.5 + r.random::<f64>();
+        let (_, cache) = head::forward(&spec, batch, &h, &params, &y).expect("shapes");
+        let grads = head::backward(&spec, &cache, &params, g).expect("shapes");
+        let what = format!("seed {seed}: {spec:?} B {batch}");
+        let f = |h: &[f64], p: &[f64], y: &[f64]| {
+            g * head::forward(&spec, batch, h, p, y).expect("shapes").0
+        };
+        check_fd(&format!("{what}: dh"), &h, &grads.h, |v| f(v, &params, &y));
+        check_fd(
+            &format!("{what}: parameters"),
+            &params,
+            &grads.params,
+            |v| f(&h, v, &y),
+        );
+        check_fd(&format!("{what}: dy"), &y, &grads.y, |v| f(&h, &params, v));
     }
 }
 
