@@ -7,7 +7,7 @@
 //! `dW_hh = H_{prev}ᵀ dA`, `db = Σ dA`, `dX = dA W_ihᵀ`, one product each.
 
 use super::bridge;
-use super::{Mat, Real, add_column_sums, cell_backward, cell_forward, gemm};
+use super::{Mat, Real, add_column_sums, cell_backward, cell_forward, gemm, gemm_by_transpose};
 use crate::error::{NeuralError, Result};
 use burn::backend::flex::FlexTensor;
 use burn::tensor::Tensor;
@@ -141,7 +141,7 @@ pub(crate) fn forward<T: Real>(
         let (c_done, c_rest) = cs.split_at_mut(t * bh);
         let a = &mut gates[t * bg..(t + 1) * bg];
         let c_prev = if t > 0 {
-            gemm(
+            gemm_by_transpose(
                 Mat::new(&h_done[(t - 1) * bh..], batch, hidden),
                 Mat::new(w_hh, hidden, g4),
                 T::one(),
