@@ -121,9 +121,9 @@ pub(crate) fn forward<T: Real>(
     check_len(w_hh, hidden * g4, "fused LSTM recurrent weights")?;
     let xt = swap_01(x, batch, steps, input);
     let rows = dims.rows();
-    let mut gates = vec![T::zero(); rows * g4];
-    for row in gates.chunks_exact_mut(g4) {
-        row.copy_from_slice(b);
+    let mut gates = Vec::with_capacity(rows * g4);
+    for _ in 0..rows {
+        gates.extend_from_slice(b);
     }
     gemm(
         Mat::new(&xt, rows, input),
@@ -285,8 +285,8 @@ pub(crate) fn backward<T: Real>(
 #[derive(Debug, Clone)]
 pub(crate) struct State {
     cache: Cache<f32>,
-    w_ih: Vec<f32>,
-    w_hh: Vec<f32>,
+    w_ih: bridge::Kept,
+    w_hh: bridge::Kept,
     /// Whether the op's output is the last step's hidden states only.
     last: bool,
 }
@@ -316,7 +316,9 @@ impl bridge::FusedState<4> for State {
         } else {
             OutGrad::All(dh)
         };
-        let g = backward(&self.cache, &self.w_ih, &self.w_hh, dh, need_x)?;
+        let w_ih = self.w_ih.values("LSTM input weights")?;
+        let w_hh = self.w_hh.values("LSTM recurrent weights")?;
+        let g = backward(&self.cache, &w_ih, &w_hh, dh, need_x)?;
         Ok([g.dx.unwrap_or_default(), g.dw_ih, g.db, g.dw_hh])
     }
 }
@@ -395,8 +397,8 @@ fn run<const D: usize>(
             out,
             State {
                 cache,
-                w_ih: w_ih.into_owned(),
-                w_hh: w_hh.into_owned(),
+                w_ih: bridge::Kept::new(&t[1]),
+                w_hh: bridge::Kept::new(&t[3]),
                 last,
             },
         ))
