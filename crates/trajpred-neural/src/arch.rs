@@ -31,6 +31,12 @@ pub trait Architecture:
     fn build(&self, features: usize, window: usize, outputs: usize, device: &Device) -> Self::Net;
     /// `[batch, window, features]` -> `[batch, outputs]`.
     fn forward(&self, net: &Self::Net, x: Tensor<3>) -> Tensor<2>;
+    /// The training loss of a batch: the mean squared error of [`Architecture::forward`]
+    /// on `x` against the targets `y` (`[batch, outputs]`), a one-element tensor. An
+    /// architecture may compute the same in fewer tensor operations (the LSTM's fused path).
+    fn loss(&self, net: &Self::Net, x: Tensor<3>, y: Tensor<2>) -> Tensor<1> {
+        crate::train::mse(self.forward(net, x), y)
+    }
     /// Applies the choices of the training configuration that live in the network (the
     /// LSTM's [`TrainConfig::fused`]); the default keeps the network as it is.
     fn configure(&self, net: Self::Net, _train: &TrainConfig) -> Self::Net {
@@ -133,6 +139,24 @@ impl Head {
             });
         }
         v
+    }
+
+    /// The sizes of the fused head op (`src/fused/head.rs`) on inputs of width `input`.
+    pub(crate) fn fused_spec(&self, input: usize) -> crate::fused::head::Spec {
+        crate::fused::head::Spec {
+            input,
+            fc: self.hidden.iter().map(|l| l.weight.dims()[1]).collect(),
+            output: self.out.weight.dims()[1],
+            activation: self.activation,
+        }
+    }
+
+    /// The mean squared error of the head on `h` against `y` as one fused op; `None` when
+    /// the tensors do not allow it.
+    pub(crate) fn fused_mse(&self, h: Tensor<2>, y: Tensor<2>) -> Option<Tensor<1>> {
+        let spec = self.fused_spec(h.dims()[1]);
+        let params = Tensor::cat(self.fused_params(), 0);
+        crate::fused::head::mse(h, params, y, &spec).ok()
     }
 
     pub(crate) fn forward(&self, mut x: Tensor<2>) -> Tensor<2> {
@@ -393,15 +417,17 @@ impl FusedLstm {
     }
 }
 
-/// The last hidden state of stacked layers, each layer one fused op over the window; `None`
-/// when the tensors are not on the flex backend (then the composed path runs).
+/// The last hidden state of stacked layers, each layer one fused op over the window (the
+/// top one returning its last step only); `None` when the tensors are not on the flex
+/// backend, or there is no layer or no step (then the composed path runs).
 fn fused_stack(layers: &[FusedLstm], mut x: Tensor<3>) -> Option<Tensor<2>> {
-    for l in layers {
+    let (top, below) = layers.split_last()?;
+    for l in below {
         let (w_ih, b, w_hh) = l.fused_params();
         x = crate::fused::lstm::layer(x, w_ih, b, w_hh).ok()?;
     }
-    let [b, m, h] = x.dims();
-    (m > 0).then(|| x.slice([0..b, m - 1..m, 0..h]).reshape([b, h]))
+    let (w_ih, b, w_hh) = top.fused_params();
+    crate::fused::lstm::layer_last(x, w_ih, b, w_hh).ok()
 }
 
 impl Architecture for RnnArch {
@@ -451,6 +477,16 @@ impl Architecture for LstmArch {
     fn configure(&self, mut net: LstmStack, train: &TrainConfig) -> LstmStack {
         net.fused = train.fused;
         net
+    }
+    /// With the fused ops, the stacked layers and then the head and the loss, each one op.
+    fn loss(&self, net: &LstmStack, x: Tensor<3>, y: Tensor<2>) -> Tensor<1> {
+        if net.fused
+            && let Some(h) = fused_stack(&net.layers, x.clone())
+            && let Some(loss) = net.head.fused_mse(h, y.clone())
+        {
+            return loss;
+        }
+        crate::train::mse(self.forward(net, x), y)
     }
     /// Step by step through all layers at once (layer `l` at step `t` reads layer `l - 1`
     /// at step `t`): only the last layer's final hidden state is used, so no layer's

@@ -79,10 +79,12 @@ pub struct TrainConfig {
     /// Optional clipping of the gradient's global L2 norm.
     pub grad_clip_norm: Option<f64>,
     /// Whether the LSTM and the KFU-LSTM-Net run through the fused ops with their own
-    /// backward pass (one autodiff node per LSTM layer / per unrolled filter) instead of
-    /// burn's per-operation autodiff, the reference. The same weights give the same
-    /// predictions either way up to `f32` rounding (see `docs/neural.md`). Default `true`;
-    /// the other models ignore it.
+    /// backward pass (one autodiff node per LSTM layer / per unrolled filter, one for the
+    /// windowed LSTM's head and loss) instead of burn's per-operation autodiff, the
+    /// reference; with it, Adam runs in one loop per parameter (burn's updates bit for bit).
+    /// The same weights give the same predictions either way up to `f32` rounding (see
+    /// `docs/neural.md`). Default `true`; for the other models it switches Adam's loop
+    /// only.
     #[serde(default = "fused_default")]
     pub fused: bool,
 }

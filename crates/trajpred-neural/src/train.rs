@@ -3,10 +3,13 @@
 
 use crate::config::{EpochReport, Optimizer, Progress, TrainConfig, TrainReport};
 use crate::error::{NeuralError, Result};
+use crate::fused::adam::FusedAdam;
 use burn::grad_clipping::GradientClippingConfig;
 use burn::lr_scheduler::module_lr_scheduler::ModuleLrScheduler;
 use burn::module::{Module, ModuleMapper, Param};
-use burn::optim::{AdamConfig, GradientsParams, SgdConfig, momentum::MomentumConfig};
+use burn::optim::{
+    AdamConfig, GradientsParams, ModuleOptimizer, SgdConfig, momentum::MomentumConfig,
+};
 use burn::tensor::{Device, Tensor, TensorData};
 use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
@@ -175,6 +178,14 @@ pub(crate) fn train_loop<N: Module>(
         .grad_clip_norm
         .map(|c| GradientClippingConfig::Norm(c as f32));
     let mut optim = match cfg.optimizer {
+        // with the fused ops, Adam in one loop per parameter (burn's updates bit for bit)
+        Optimizer::Adam { epsilon } if cfg.fused => {
+            let optim = ModuleOptimizer::from(FusedAdam::new(epsilon as f32));
+            match clip {
+                Some(c) => optim.with_grad_clipping(c.init()),
+                None => optim,
+            }
+        }
         Optimizer::Adam { epsilon } => AdamConfig::new()
             .with_epsilon(epsilon as f32)
             .with_grad_clipping(clip)

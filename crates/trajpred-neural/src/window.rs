@@ -7,8 +7,7 @@ use crate::config::{Activation, AxisMode, EpochReport, Optimizer, TrainConfig, T
 use crate::error::{NeuralError, Result};
 use crate::persist;
 use crate::train::{
-    LoopSpec, Standardizer, XavierZeroBias, check_finite, common_dim, device, mse, read, rng,
-    train_loop,
+    LoopSpec, Standardizer, XavierZeroBias, check_finite, common_dim, device, read, rng, train_loop,
 };
 use burn::lr_scheduler::module_lr_scheduler::ModuleLrScheduler;
 use burn::module::Module;
@@ -411,14 +410,14 @@ impl<A: Architecture> WindowNet<A> {
         let dev = &device;
         let batch_loss = move |n: &A::Net, idx: &[usize]| {
             let (x, y) = tr.batch(idx, dev);
-            mse(arch.forward(n, x), y)
+            arch.loss(n, x, y)
         };
         let validation_loss = move |n: &A::Net| -> Result<f64> {
             let mut total = 0.0;
             let all: Vec<usize> = (0..va.n).collect();
             for idx in all.chunks(256) {
                 let (x, y) = va.batch(idx, dev);
-                let l = crate::train::read_scalar(mse(arch.forward(n, x), y))?;
+                let l = crate::train::read_scalar(arch.loss(n, x, y))?;
                 total += l * idx.len() as f64;
             }
             Ok(total / va.n.max(1) as f64)

@@ -59,6 +59,28 @@ pub(crate) fn values<'a>(t: &'a FlexTensor, what: &str) -> Result<Cow<'a, [f32]>
     }
 }
 
+/// A flex tensor an op's backward state keeps (a shared handle, no copy of the values).
+#[derive(Clone)]
+pub(crate) struct Kept(FlexTensor);
+
+impl Kept {
+    /// Keeps `t`.
+    pub(crate) fn new(t: &FlexTensor) -> Self {
+        Kept(t.clone())
+    }
+
+    /// The `f32` values, row-major (see [`values`]).
+    pub(crate) fn values(&self, what: &str) -> Result<Cow<'_, [f32]>> {
+        values(&self.0, what)
+    }
+}
+
+impl std::fmt::Debug for Kept {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Kept({:?})", self.0.layout().shape())
+    }
+}
+
 /// A contiguous flex tensor owning `v`.
 pub(crate) fn flex(v: Vec<f32>, shape: &[usize]) -> FlexTensor {
     FlexTensor::from_data(TensorData::new(v, shape.to_vec()))

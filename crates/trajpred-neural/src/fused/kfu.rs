@@ -12,7 +12,9 @@
 //! matrix product per weight at the end.
 
 use super::bridge;
-use super::{Mat, Real, add_column_sums, cell_backward, cell_forward, gemm};
+use super::{
+    Mat, Real, activate, activate_backward, add_column_sums, cell_backward, cell_forward, gemm,
+};
 use crate::config::Activation;
 use crate::error::{NeuralError, Result};
 use burn::backend::flex::FlexTensor;
@@ -101,30 +103,6 @@ impl Spec {
     #[cfg(test)]
     pub(crate) fn n_params(&self) -> usize {
         self.offsets().total
-    }
-}
-
-fn activate<T: Real>(a: Activation, v: &mut [T]) {
-    for x in v {
-        *x = match a {
-            Activation::Relu => x.max(T::zero()),
-            Activation::Tanh => super::tanh(*x),
-            Activation::Sigmoid => super::sigmoid(*x),
-        };
-    }
-}
-
-/// Multiplies `g` by the activation's derivative, given the activated outputs `y`.
-fn activate_backward<T: Real>(a: Activation, y: &[T], g: &mut [T]) {
-    let one = T::one();
-    for (g, &y) in g.iter_mut().zip(y) {
-        *g = *g
-            * match a {
-                Activation::Relu if y > T::zero() => one,
-                Activation::Relu => T::zero(),
-                Activation::Tanh => one - y * y,
-                Activation::Sigmoid => y * (one - y),
-            };
     }
 }
 

@@ -7,7 +7,7 @@
 //! `dW_hh = H_{prev}ᵀ dA`, `db = Σ dA`, `dX = dA W_ihᵀ`, one product each.
 
 use super::bridge;
-use super::{Mat, Real, add_column_sums, cell_backward, cell_forward, gemm};
+use super::{Mat, Real, add_column_sums, cell_backward, cell_forward, gemm, gemm_by_transpose};
 use crate::error::{NeuralError, Result};
 use burn::backend::flex::FlexTensor;
 use burn::tensor::Tensor;
@@ -79,15 +79,35 @@ fn swap_01<T: Copy>(v: &[T], n0: usize, n1: usize, f: usize) -> Vec<T> {
     out
 }
 
+impl<T: Copy> Cache<T> {
+    /// The hidden states `[B, T, H]`.
+    pub(crate) fn output(&self) -> Vec<T> {
+        let Dims {
+            batch,
+            steps,
+            hidden,
+            ..
+        } = self.dims;
+        swap_01(&self.hs, steps, batch, hidden)
+    }
+
+    /// The hidden states of the last step `[B, H]` (empty without steps).
+    pub(crate) fn last(&self) -> &[T] {
+        let bh = self.dims.batch * self.dims.hidden;
+        &self.hs[self.hs.len().saturating_sub(bh)..]
+    }
+}
+
 /// The forward pass: `x` `[B, T, D]`, `w_ih` `[D, 4H]`, `b` `[4H]`, `w_hh` `[H, 4H]`;
-/// returns the hidden states `[B, T, H]` and the cache of the backward pass.
+/// returns the cache of the backward pass, which holds the hidden states
+/// ([`Cache::output`], [`Cache::last`]).
 pub(crate) fn forward<T: Real>(
     dims: Dims,
     x: &[T],
     w_ih: &[T],
     b: &[T],
     w_hh: &[T],
-) -> Result<(Vec<T>, Cache<T>)> {
+) -> Result<Cache<T>> {
     let Dims {
         batch,
         steps,
@@ -101,9 +121,9 @@ pub(crate) fn forward<T: Real>(
     check_len(w_hh, hidden * g4, "fused LSTM recurrent weights")?;
     let xt = swap_01(x, batch, steps, input);
     let rows = dims.rows();
-    let mut gates = vec![T::zero(); rows * g4];
-    for row in gates.chunks_exact_mut(g4) {
-        row.copy_from_slice(b);
+    let mut gates = Vec::with_capacity(rows * g4);
+    for _ in 0..rows {
+        gates.extend_from_slice(b);
     }
     gemm(
         Mat::new(&xt, rows, input),
@@ -121,7 +141,7 @@ pub(crate) fn forward<T: Real>(
         let (c_done, c_rest) = cs.split_at_mut(t * bh);
         let a = &mut gates[t * bg..(t + 1) * bg];
         let c_prev = if t > 0 {
-            gemm(
+            gemm_by_transpose(
                 Mat::new(&h_done[(t - 1) * bh..], batch, hidden),
                 Mat::new(w_hh, hidden, g4),
                 T::one(),
@@ -140,26 +160,32 @@ pub(crate) fn forward<T: Real>(
             &mut h_rest[..bh],
         );
     }
-    let out = swap_01(&hs, steps, batch, hidden);
-    Ok((
-        out,
-        Cache {
-            dims,
-            xt,
-            gates,
-            cs,
-            tcs,
-            hs,
-        },
-    ))
+    Ok(Cache {
+        dims,
+        xt,
+        gates,
+        cs,
+        tcs,
+        hs,
+    })
 }
 
-/// The backward pass from the gradient `dh` of the hidden states `[B, T, H]`.
+/// The gradient of a layer's output: of every hidden state `[B, T, H]`, or of the last
+/// step's only `[B, H]` (the other steps' being zero).
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum OutGrad<'a, T> {
+    /// `[B, T, H]`.
+    All(&'a [T]),
+    /// `[B, H]`, the last step.
+    Last(&'a [T]),
+}
+
+/// The backward pass from the gradient `dh` of the hidden states.
 pub(crate) fn backward<T: Real>(
     cache: &Cache<T>,
     w_ih: &[T],
     w_hh: &[T],
-    dh: &[T],
+    dh: OutGrad<'_, T>,
     need_dx: bool,
 ) -> Result<Grads<T>> {
     let Dims {
@@ -170,10 +196,20 @@ pub(crate) fn backward<T: Real>(
     } = cache.dims;
     let g4 = 4 * hidden;
     let rows = cache.dims.rows();
-    check_len(dh, rows * hidden, "fused LSTM output gradient")?;
-    let dht = swap_01(dh, batch, steps, hidden);
     let zero = T::zero();
     let (bh, bg) = (batch * hidden, batch * g4);
+    let dht = match dh {
+        OutGrad::All(dh) => {
+            check_len(dh, rows * hidden, "fused LSTM output gradient")?;
+            swap_01(dh, batch, steps, hidden)
+        }
+        OutGrad::Last(dh) => {
+            check_len(dh, bh.min(rows * hidden), "fused LSTM last-step gradient")?;
+            let mut v = vec![zero; rows * hidden];
+            v[rows * hidden - dh.len()..].copy_from_slice(dh);
+            v
+        }
+    };
     let mut da = vec![zero; rows * g4];
     let mut dh_next = vec![zero; bh];
     let mut dc = vec![zero; bh];
@@ -249,8 +285,10 @@ pub(crate) fn backward<T: Real>(
 #[derive(Debug, Clone)]
 pub(crate) struct State {
     cache: Cache<f32>,
-    w_ih: Vec<f32>,
-    w_hh: Vec<f32>,
+    w_ih: bridge::Kept,
+    w_hh: bridge::Kept,
+    /// Whether the op's output is the last step's hidden states only.
+    last: bool,
 }
 
 /// A fused LSTM layer's inputs: `x`, `W_ih`, `b`, `W_hh`.
@@ -273,7 +311,14 @@ impl bridge::FusedState<4> for State {
     }
 
     fn gradients(&self, dh: &[f32], [need_x, ..]: [bool; 4]) -> Result<[Vec<f32>; 4]> {
-        let g = backward(&self.cache, &self.w_ih, &self.w_hh, dh, need_x)?;
+        let dh = if self.last {
+            OutGrad::Last(dh)
+        } else {
+            OutGrad::All(dh)
+        };
+        let w_ih = self.w_ih.values("LSTM input weights")?;
+        let w_hh = self.w_hh.values("LSTM recurrent weights")?;
+        let g = backward(&self.cache, &w_ih, &w_hh, dh, need_x)?;
         Ok([g.dx.unwrap_or_default(), g.dw_ih, g.db, g.dw_hh])
     }
 }
@@ -289,6 +334,28 @@ pub(crate) fn layer(
     b: Tensor<1>,
     w_hh: Tensor<2>,
 ) -> Result<Tensor<3>> {
+    run(x, w_ih, b, w_hh, false)
+}
+
+/// [`layer`] returning the last step's hidden states `[B, H]` only (what the windowed
+/// model's head reads): no slice of the whole sequence, nor its gradient, in burn's graph.
+/// Errors also for a sequence without steps.
+pub(crate) fn layer_last(
+    x: Tensor<3>,
+    w_ih: Tensor<2>,
+    b: Tensor<1>,
+    w_hh: Tensor<2>,
+) -> Result<Tensor<2>> {
+    run(x, w_ih, b, w_hh, true)
+}
+
+fn run<const D: usize>(
+    x: Tensor<3>,
+    w_ih: Tensor<2>,
+    b: Tensor<1>,
+    w_hh: Tensor<2>,
+    last: bool,
+) -> Result<Tensor<D>> {
     let [batch, steps, input] = x.dims();
     let [_, g4] = w_ih.dims();
     let dims = Dims {
@@ -297,25 +364,42 @@ pub(crate) fn layer(
         input,
         hidden: g4 / 4,
     };
+    if last && steps == 0 {
+        return Err(NeuralError::DimensionMismatch {
+            what: "fused LSTM steps",
+            expected: 1,
+            got: 0,
+        });
+    }
     let prims = vec![
         bridge::prim(x, "LSTM input")?,
         bridge::prim(w_ih, "LSTM input weights")?,
         bridge::prim(b, "LSTM bias")?,
         bridge::prim(w_hh, "LSTM recurrent weights")?,
     ];
-    let shape = [batch, steps, dims.hidden];
+    let shape: Vec<usize> = if last {
+        vec![batch, dims.hidden]
+    } else {
+        vec![batch, steps, dims.hidden]
+    };
     let run = |t: &[FlexTensor]| -> Result<(Vec<f32>, State)> {
         let x = bridge::values(&t[0], "LSTM input")?;
         let w_ih = bridge::values(&t[1], "LSTM input weights")?;
         let b = bridge::values(&t[2], "LSTM bias")?;
         let w_hh = bridge::values(&t[3], "LSTM recurrent weights")?;
-        let (out, cache) = forward(dims, &x, &w_ih, &b, &w_hh)?;
+        let cache = forward(dims, &x, &w_ih, &b, &w_hh)?;
+        let out = if last {
+            cache.last().to_vec()
+        } else {
+            cache.output()
+        };
         Ok((
             out,
             State {
                 cache,
-                w_ih: w_ih.into_owned(),
-                w_hh: w_hh.into_owned(),
+                w_ih: bridge::Kept::new(&t[1]),
+                w_hh: bridge::Kept::new(&t[3]),
+                last,
             },
         ))
     };

@@ -8,22 +8,29 @@
 //! - [`lstm`]: one LSTM layer over a whole sequence. The input projection of every step is
 //!   one matrix product, the recurrent part runs step by step and keeps the activated
 //!   gates, backpropagation through time is written out, and the weight gradients are one
-//!   matrix product each at the end.
+//!   matrix product each at the end. The windowed model's top layer returns its last step
+//!   only ([`lstm::layer_last`]).
+//! - [`head`]: the windowed LSTM model's fully connected head and its mean squared error
+//!   (the training loss of a batch) as one op.
 //! - [`kfu`]: the whole unrolled Kalman-filter-unfolded LSTM (stacked LSTM transition,
 //!   fully connected head, diagonal Kalman update with learnable `Q`, `R`) over a sequence.
 //!
-//! The arithmetic is generic over `f32`/`f64` ([`Real`]): burn runs it in `f32`, the
-//! finite-difference tests in `f64`. Matrix products go through `ndarray`'s
+//! [`adam`] is the optimizer that goes with them: burn's Adam, bit for bit, in one loop per
+//! parameter. The arithmetic is generic over `f32`/`f64` ([`Real`]): burn runs it in
+//! `f32`, the finite-difference tests in `f64`. Matrix products go through `ndarray`'s
 //! `general_mat_mul` on row-major views. The autodiff-composed models stay as the reference
 //! (`TrainConfig::fused = false`); the tests in `fused/tests.rs` hold every gradient of
-//! both ops to it.
+//! the ops to it.
 
+pub(crate) mod adam;
 pub(crate) mod bridge;
+pub(crate) mod head;
 pub(crate) mod kfu;
 pub(crate) mod lstm;
 #[cfg(test)]
 mod tests;
 
+use crate::config::Activation;
 use crate::error::{NeuralError, Result};
 use ndarray::linalg::general_mat_mul;
 use ndarray::{ArrayView2, ArrayViewMut2};
@@ -32,9 +39,58 @@ use ndarray::{ArrayView2, ArrayViewMut2};
 pub(crate) trait Real:
     ndarray::LinalgScalar + num_traits::Float + Send + Sync + std::fmt::Debug
 {
+    /// `exp` as the gate nonlinearities take it: [`exp_f32`] for `f32` (a branch-free
+    /// polynomial the compiler vectorises), the standard library's `exp` for `f64` (so the
+    /// finite-difference checks see exact derivatives of what the backward passes assume).
+    fn exp_gate(self) -> Self;
 }
-impl Real for f32 {}
-impl Real for f64 {}
+impl Real for f32 {
+    #[inline(always)]
+    fn exp_gate(self) -> f32 {
+        exp_f32(self)
+    }
+}
+impl Real for f64 {
+    #[inline(always)]
+    fn exp_gate(self) -> f64 {
+        self.exp()
+    }
+}
+
+/// `exp(x)` in `f32` arithmetic without branches or calls, so that loops over slices of
+/// gates vectorise (the C library's `expf`, called per element, was a seventh of the fused
+/// LSTM epoch): Cephes' `expf`, `exp(x) = 2^n exp(r)` with `n = round(x / ln 2)` (rounded by
+/// adding `1.5 * 2^23`), `r = x - n ln 2` (in two parts) and a degree-6 polynomial for
+/// `exp(r)` on `[-ln 2 / 2, ln 2 / 2]`; `2^n` is built from its bits. `x` is clamped to
+/// `[-87, 88]` first (results between `1.6e-38` and `1.7e38`, normal numbers; `sigmoid` and
+/// `tanh` saturate long before); NaN stays NaN. Within 1 ulp of `f32::exp` on the clamped
+/// range (`exp_f32_matches_the_standard_library` in the tests).
+#[inline(always)]
+pub(crate) fn exp_f32(x: f32) -> f32 {
+    const ROUND: f32 = 12_582_912.0;
+    const LN2_HI: f32 = 0.693_359_4;
+    const LN2_LO: f32 = -2.121_944_4e-4;
+    let x = x.clamp(-87.0, 88.0);
+    let shifted = x * std::f32::consts::LOG2_E + ROUND;
+    let n = shifted - ROUND;
+    let r = x - n * LN2_HI - n * LN2_LO;
+    let p = 1.987_569_1e-4_f32;
+    let p = p * r + 1.398_199_9e-3;
+    let p = p * r + 8.333_452e-3;
+    let p = p * r + 4.166_579_6e-2;
+    let p = p * r + 1.666_666_5e-1;
+    let p = p * r + 0.5;
+    let e = p * r * r + r + 1.0;
+    // `shifted`'s bits are ROUND's plus `n` (its unit in the last place is 1 there)
+    let scale = f32::from_bits(
+        shifted
+            .to_bits()
+            .wrapping_sub(ROUND.to_bits())
+            .wrapping_add(127)
+            << 23,
+    );
+    e * scale
+}
 
 fn shape_error(what: &str) -> NeuralError {
     NeuralError::Tensor {
@@ -91,6 +147,26 @@ pub(crate) fn gemm<T: Real>(a: Mat<'_, T>, b: Mat<'_, T>, beta: T, c: &mut [T]) 
     Ok(())
 }
 
+/// [`gemm`] computed as `cᵀ = beta cᵀ + bᵀ aᵀ` (the same sums, the same `c`): for the step
+/// products `[B, H] x [H, 4H]` of a small batch, matrixmultiply's kernel runs faster over this
+/// orientation (the weight becomes its column-major left operand).
+pub(crate) fn gemm_by_transpose<T: Real>(
+    a: Mat<'_, T>,
+    b: Mat<'_, T>,
+    beta: T,
+    c: &mut [T],
+) -> Result<()> {
+    let (at, bt) = (a.t().view()?, b.t().view()?);
+    if bt.ncols() != at.nrows() {
+        return Err(shape_error("a matrix product"));
+    }
+    let mut ct = ArrayViewMut2::from_shape((at.ncols(), bt.nrows()), c)
+        .map_err(|_| shape_error("a matrix product's output"))?
+        .reversed_axes();
+    general_mat_mul(T::one(), &bt, &at, beta, &mut ct);
+    Ok(())
+}
+
 /// Adds the column sums of the row-major `[rows, cols]` matrix `m` to `out` (`[cols]`).
 pub(crate) fn add_column_sums<T: Real>(m: &[T], cols: usize, out: &mut [T]) {
     for row in m.chunks_exact(cols) {
@@ -100,24 +176,61 @@ pub(crate) fn add_column_sums<T: Real>(m: &[T], cols: usize, out: &mut [T]) {
     }
 }
 
+/// The logistic function `1 / (1 + exp(-x))`.
+#[inline(always)]
 pub(crate) fn sigmoid<T: Real>(x: T) -> T {
-    T::one() / (T::one() + (-x).exp())
+    T::one() / (T::one() + (-x).exp_gate())
 }
 
 /// `tanh(x) = 1 - 2 / (exp(2x) + 1)`: one `exp`, where the C library's `tanhf` (through
 /// `expm1f`) took a third of the LSTM epoch; saturates to `±1` without overflow trouble
 /// (`exp` going to `inf` or `0`), absolute error a few ulps of 1 (the composed model's
 /// `2 sigmoid(2x) - 1` is the same formula).
+#[inline(always)]
 pub(crate) fn tanh<T: Real>(x: T) -> T {
     let one = T::one();
-    one - (one + one) / ((x + x).exp() + one)
+    one - (one + one) / ((x + x).exp_gate() + one)
+}
+
+/// Applies the activation of fully connected hidden layers to `v` in place.
+pub(crate) fn activate<T: Real>(a: Activation, v: &mut [T]) {
+    for x in v {
+        *x = match a {
+            Activation::Relu => x.max(T::zero()),
+            Activation::Tanh => tanh(*x),
+            Activation::Sigmoid => sigmoid(*x),
+        };
+    }
+}
+
+/// Multiplies `g` by the activation's derivative, given the activated outputs `y`.
+pub(crate) fn activate_backward<T: Real>(a: Activation, y: &[T], g: &mut [T]) {
+    let one = T::one();
+    for (g, &y) in g.iter_mut().zip(y) {
+        *g = *g
+            * match a {
+                Activation::Relu if y > T::zero() => one,
+                Activation::Relu => T::zero(),
+                Activation::Tanh => one - y * y,
+                Activation::Sigmoid => y * (one - y),
+            };
+    }
+}
+
+/// The four gate blocks `[i f g o]` of one row of `4h` values.
+fn gate_blocks<T>(row: &[T], h: usize) -> (&[T], &[T], &[T], &[T]) {
+    let (i, rest) = row.split_at(h);
+    let (f, rest) = rest.split_at(h);
+    let (g, o) = rest.split_at(h);
+    (i, f, g, o)
 }
 
 /// One LSTM step on `rows` rows, gates in PyTorch's order `[i f g o]`.
 ///
 /// `a` (`[rows, 4h]`) holds the pre-activations and is overwritten with the activated gates
 /// (`sigmoid` for `i`, `f`, `o`, `tanh` for `g`); writes `c = f c_prev + i g`, `tc = tanh(c)`
-/// and `h = o tc` (each `[rows, h]`). `c_prev = None` is the zero state.
+/// and `h = o tc` (each `[rows, h]`). `c_prev = None` is the zero state. Every loop runs
+/// over contiguous slices without branches, so that it vectorises.
 pub(crate) fn cell_forward<T: Real>(
     h: usize,
     a: &mut [T],
@@ -127,23 +240,42 @@ pub(crate) fn cell_forward<T: Real>(
     hout: &mut [T],
 ) {
     let g4 = 4 * h;
-    for (r, gates) in a.chunks_exact_mut(g4).enumerate() {
-        for j in 0..h {
-            let i = sigmoid(gates[j]);
-            let f = sigmoid(gates[h + j]);
-            let g = tanh(gates[2 * h + j]);
-            let o = sigmoid(gates[3 * h + j]);
-            gates[j] = i;
-            gates[h + j] = f;
-            gates[2 * h + j] = g;
-            gates[3 * h + j] = o;
-            let k = r * h + j;
-            let cp = c_prev.map_or(T::zero(), |cp| cp[k]);
-            let cn = f * cp + i * g;
-            let t = tanh(cn);
-            c[k] = cn;
-            tc[k] = t;
-            hout[k] = o * t;
+    let zeros;
+    let c_prev = match c_prev {
+        Some(cp) => cp,
+        None => {
+            zeros = vec![T::zero(); c.len()];
+            &zeros
+        }
+    };
+    for ((((gates, cp), c), tc), hout) in a
+        .chunks_exact_mut(g4)
+        .zip(c_prev.chunks_exact(h))
+        .zip(c.chunks_exact_mut(h))
+        .zip(tc.chunks_exact_mut(h))
+        .zip(hout.chunks_exact_mut(h))
+    {
+        let (ifg, o) = gates.split_at_mut(3 * h);
+        let (i_f, g) = ifg.split_at_mut(2 * h);
+        // one loop per block: a chained iterator would not vectorise
+        for v in i_f.iter_mut() {
+            *v = sigmoid(*v);
+        }
+        for v in o.iter_mut() {
+            *v = sigmoid(*v);
+        }
+        for v in g.iter_mut() {
+            *v = tanh(*v);
+        }
+        let (i, f, g, o) = gate_blocks(gates, h);
+        for ((((c, &cp), &i), &f), &g) in c.iter_mut().zip(cp).zip(i).zip(f).zip(g) {
+            *c = f * cp + i * g;
+        }
+        for (t, &c) in tc.iter_mut().zip(c.iter()) {
+            *t = tanh(c);
+        }
+        for ((hv, &t), &o) in hout.iter_mut().zip(tc.iter()).zip(o) {
+            *hv = o * t;
         }
     }
 }
@@ -164,23 +296,35 @@ pub(crate) fn cell_backward<T: Real>(
 ) {
     let g4 = 4 * h;
     let one = T::one();
-    for (r, (gt, dat)) in gates
+    let zeros;
+    let c_prev = match c_prev {
+        Some(cp) => cp,
+        None => {
+            zeros = vec![T::zero(); dc.len()];
+            &zeros
+        }
+    };
+    for (((((gt, dat), cp), tc), dh), dc) in gates
         .chunks_exact(g4)
         .zip(da.chunks_exact_mut(g4))
-        .enumerate()
+        .zip(c_prev.chunks_exact(h))
+        .zip(tc.chunks_exact(h))
+        .zip(dh.chunks_exact(h))
+        .zip(dc.chunks_exact_mut(h))
     {
+        let (i, f, g, o) = gate_blocks(gt, h);
+        let (d_i, rest) = dat.split_at_mut(h);
+        let (d_f, rest) = rest.split_at_mut(h);
+        let (d_g, d_o) = rest.split_at_mut(h);
         for j in 0..h {
-            let (i, f, g, o) = (gt[j], gt[h + j], gt[2 * h + j], gt[3 * h + j]);
-            let k = r * h + j;
-            let t = tc[k];
-            let d_o = dh[k] * t;
-            let dct = dc[k] + dh[k] * o * (one - t * t);
-            let cp = c_prev.map_or(T::zero(), |cp| cp[k]);
-            dat[j] = dct * g * i * (one - i);
-            dat[h + j] = dct * cp * f * (one - f);
-            dat[2 * h + j] = dct * i * (one - g * g);
-            dat[3 * h + j] = d_o * o * (one - o);
-            dc[k] = dct * f;
+            let (i, f, g, o) = (i[j], f[j], g[j], o[j]);
+            let t = tc[j];
+            let dct = dc[j] + dh[j] * o * (one - t * t);
+            d_i[j] = dct * g * i * (one - i);
+            d_f[j] = dct * cp[j] * f * (one - f);
+            d_g[j] = dct * i * (one - g * g);
+            d_o[j] = dh[j] * t * o * (one - o);
+            dc[j] = dct * f;
         }
     }
 }

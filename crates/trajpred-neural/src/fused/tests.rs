@@ -4,13 +4,14 @@
 //! magnitude of that gradient (f32); the backward passes equal central finite differences
 //! of the forward passes in f64; and the outputs agree within `1e-5` (f32).
 
-use super::{kfu, lstm};
+use super::{adam, head, kfu, lstm};
 use crate::arch::{Architecture, FusedLstm, LstmArch, RecurrentLayers};
 use crate::config::{Activation, TrainConfig};
 use crate::kfu::{KfuCell, KfuConfig};
 use crate::train::{device, read, rng};
+use burn::grad_clipping::GradientClippingConfig;
 use burn::module::{Module, ModuleMapper, ModuleVisitor, Param};
-use burn::optim::GradientsParams;
+use burn::optim::{GradientsParams, ModuleOptimizer};
 use burn::tensor::{Device, Tensor, TensorData};
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
@@ -311,7 +312,8 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-/// The LSTM layer's backward pass equals finite differences of its forward pass (f64).
+/// The LSTM layer's backward pass equals finite differences of its forward pass (f64), from
+/// the gradient of every hidden state (even seeds) or of the last step's only (odd seeds).
 #[test]
 fn lstm_backward_equals_finite_differences() {
     for seed in 0..6u64 {
@@ -327,12 +329,23 @@ fn lstm_backward_equals_finite_differences() {
         let w_ih = uniform64(&mut r, d * 4 * h, 0.7);
         let bias = uniform64(&mut r, 4 * h, 0.7);
         let w_hh = uniform64(&mut r, h * 4 * h, 0.7);
-        let w = uniform64(&mut r, b * t * h, 1.0);
-        let (_, cache) = lstm::forward(dims, &x, &w_ih, &bias, &w_hh).expect("shapes");
-        let g = lstm::backward(&cache, &w_ih, &w_hh, &w, true).expect("shapes");
-        let what = format!("seed {seed}: {dims:?}");
+        let last = seed % 2 == 1;
+        let w = uniform64(&mut r, b * if last { 1 } else { t } * h, 1.0);
+        let cache = lstm::forward(dims, &x, &w_ih, &bias, &w_hh).expect("shapes");
+        let dh = if last {
+            lstm::OutGrad::Last(&w)
+        } else {
+            lstm::OutGrad::All(&w)
+        };
+        let g = lstm::backward(&cache, &w_ih, &w_hh, dh, true).expect("shapes");
+        let what = format!("seed {seed}: {dims:?}, last step only: {last}");
         let f = |x: &[f64], wi: &[f64], bb: &[f64], wh: &[f64]| {
-            dot(&lstm::forward(dims, x, wi, bb, wh).expect("shapes").0, &w)
+            let c = lstm::forward(dims, x, wi, bb, wh).expect("shapes");
+            if last {
+                dot(c.last(), &w)
+            } else {
+                dot(&c.output(), &w)
+            }
         };
         check_fd(&format!("{what}: dx"), &x, &g.dx.unwrap_or_default(), |p| {
             f(p, &w_ih, &bias, &w_hh)
@@ -346,6 +359,102 @@ fn lstm_backward_equals_finite_differences() {
         check_fd(&format!("{what}: dW_hh"), &w_hh, &g.dw_hh, |p| {
             f(&x, &w_ih, &bias, p)
         });
+    }
+}
+
+/// The windowed LSTM model's training loss: the fused path (stacked layers, the top one
+/// returning its last step, then the head and the mean squared error as one op) against
+/// burn's autodiff through the composed network and `mse`: the loss, and the gradient of
+/// every parameter, of the input windows and of the targets.
+#[test]
+fn lstm_loss_gradients_equal_the_composed_reference() {
+    let device = device();
+    let acts = [Activation::Relu, Activation::Tanh, Activation::Sigmoid];
+    for seed in 0..12u64 {
+        let mut r = rng(seed, 14);
+        let arch = LstmArch(RecurrentLayers {
+            layers: (0..r.random_range(1..4))
+                .map(|_| r.random_range(1..9))
+                .collect(),
+            fc: (0..r.random_range(0..3))
+                .map(|_| r.random_range(1..6))
+                .collect(),
+            activation: acts[r.random_range(0..3)],
+        });
+        let (b, m, f, out) = (
+            r.random_range(1..6),
+            r.random_range(1..7),
+            r.random_range(1..4),
+            r.random_range(1..5),
+        );
+        let net = arch.build(f, m, out, &device).map(&mut Fill {
+            rng: &mut r,
+            scale: 0.5,
+        });
+        let (xv, yv) = (
+            uniform(&mut r, b * m * f, 1.5),
+            uniform(&mut r, b * out, 1.0),
+        );
+        let what = format!("seed {seed}: {arch:?} B {b} m {m} f {f} out {out}");
+        let mut results = Vec::new();
+        for fused in [true, false] {
+            let net = arch.configure(net.clone(), &TrainConfig::new(1e-3).with_fused(fused));
+            let x = tensor(xv.clone(), [b, m, f], &device).require_grad();
+            let y = tensor(yv.clone(), [b, out], &device).require_grad();
+            let loss = arch.loss(&net, x.clone(), y.clone());
+            let value = read(loss.clone()).expect("f32");
+            let grads = loss.backward();
+            let gx = read(x.grad(&grads).expect("input gradient")).expect("f32");
+            let gy = read(y.grad(&grads).expect("target gradient")).expect("f32");
+            let gp = GradientsParams::from_grads(grads, &net);
+            results.push((value, gx, gy, collect(&gp, &net)));
+        }
+        let (value, gx, gy, gp) = &results[0];
+        let (value_ref, gx_ref, gy_ref, gp_ref) = &results[1];
+        assert_close(value, value_ref, OUT_TOL, &format!("{what}: loss"));
+        assert_close(gx, gx_ref, GRAD_TOL, &format!("{what}: dx"));
+        assert_close(gy, gy_ref, GRAD_TOL, &format!("{what}: dy"));
+        assert_eq!(gp.len(), gp_ref.len());
+        for (k, (a, e)) in gp.iter().zip(gp_ref).enumerate() {
+            assert_param(a, e, &format!("{what}: parameter {k}"));
+        }
+    }
+}
+
+/// The fused head's backward pass equals finite differences of its loss (f64), for the
+/// input, every packed parameter and the targets.
+#[test]
+fn head_backward_equals_finite_differences() {
+    let acts = [Activation::Relu, Activation::Tanh, Activation::Sigmoid];
+    for seed in 0..6u64 {
+        let mut r = rng(seed, 15);
+        let spec = head::Spec {
+            input: r.random_range(1..5),
+            fc: (0..r.random_range(0..3))
+                .map(|_| r.random_range(1..5))
+                .collect(),
+            output: r.random_range(1..4),
+            activation: acts[(seed % 3) as usize],
+        };
+        let batch = r.random_range(1..4);
+        let h = uniform64(&mut r, batch * spec.input, 1.5);
+        let params = uniform64(&mut r, spec.n_params(), 0.7);
+        let y = uniform64(&mut r, batch * spec.output, 1.0);
+        let g = 0.5 + r.random::<f64>();
+        let (_, cache) = head::forward(&spec, batch, &h, &params, &y).expect("shapes");
+        let grads = head::backward(&spec, &cache, &params, g).expect("shapes");
+        let what = format!("seed {seed}: {spec:?} B {batch}");
+        let f = |h: &[f64], p: &[f64], y: &[f64]| {
+            g * head::forward(&spec, batch, h, p, y).expect("shapes").0
+        };
+        check_fd(&format!("{what}: dh"), &h, &grads.h, |v| f(v, &params, &y));
+        check_fd(
+            &format!("{what}: parameters"),
+            &params,
+            &grads.params,
+            |v| f(&h, v, &y),
+        );
+        check_fd(&format!("{what}: dy"), &y, &grads.y, |v| f(&h, &params, v));
     }
 }
 
@@ -454,5 +563,132 @@ fn plain_weights_with_autodiff_data_run_fused() {
             OUT_TOL,
             "ahead",
         );
+    }
+}
+
+/// The gates' `exp` ([`super::exp_f32`]) is within 1 ulp of the standard library's on
+/// `[-87, 88]`, clamps outside it (staying finite and positive), and keeps NaN.
+#[test]
+fn exp_f32_matches_the_standard_library() {
+    let ulp = |v: f32| f32::from_bits(v.to_bits() + 1) - v;
+    let mut worst = 0f32;
+    let mut x = -87.0f32;
+    while x <= 88.0 {
+        let (fast, exact) = (super::exp_f32(x), x.exp());
+        worst = worst.max((fast - exact).abs() / ulp(exact));
+        x += 0.001_3;
+    }
+    for x in [0.0f32, 1e-8, -1e-8, 0.5, -0.5, 1.0, -1.0, 20.0, -20.0] {
+        let (fast, exact) = (super::exp_f32(x), x.exp());
+        worst = worst.max((fast - exact).abs() / ulp(exact));
+    }
+    assert!(worst <= 1.0, "max error {worst} ulp");
+    assert_eq!(super::exp_f32(-1e4), super::exp_f32(-87.0));
+    assert_eq!(super::exp_f32(1e4), super::exp_f32(88.0));
+    assert!(super::exp_f32(f32::INFINITY).is_finite());
+    assert!(super::exp_f32(f32::NEG_INFINITY) > 0.0);
+    assert!(super::exp_f32(f32::NAN).is_nan());
+}
+
+/// Collects the values of every parameter, in visiting order.
+struct Values(Vec<Vec<f32>>);
+
+impl ModuleVisitor for Values {
+    fn visit_float<const D: usize>(&mut self, param: &Param<Tensor<D>>) {
+        self.0.push(read(param.val()).unwrap_or_default());
+    }
+}
+
+/// Five Adam steps of `fused` and burn's `Adam` from the same module, each on the gradient
+/// of `loss` at its own parameters and input `k`: every parameter stays bit for bit equal.
+fn assert_adam_steps<M: Module>(
+    what: &str,
+    module: M,
+    clip: Option<f32>,
+    loss: impl Fn(&M, u64) -> Tensor<1>,
+) {
+    let optimizer = |fused: bool| {
+        let o = if fused {
+            ModuleOptimizer::from(adam::FusedAdam::new(1e-8))
+        } else {
+            adam::FusedAdam::config(1e-8).init()
+        };
+        match clip {
+            Some(c) => o.with_grad_clipping(GradientClippingConfig::Norm(c).init()),
+            None => o,
+        }
+    };
+    let mut modules = [module.clone(), module];
+    let mut optims = [optimizer(true), optimizer(false)];
+    for step in 0..5 {
+        for (m, o) in modules.iter_mut().zip(&mut optims) {
+            let grads = GradientsParams::from_grads(loss(m, step).backward(), m);
+            *m = o.step(1e-2, m.clone(), grads);
+        }
+        let [fused, reference] = modules.each_ref().map(|m| {
+            let mut v = Values(Vec::new());
+            m.visit(&mut v);
+            v.0
+        });
+        assert_eq!(fused.len(), reference.len());
+        for (k, (a, b)) in fused.iter().zip(&reference).enumerate() {
+            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert!(
+                !a.is_empty() && bits(a) == bits(b),
+                "{what}, clip {clip:?}, step {step}: parameter {k} differs"
+            );
+        }
+    }
+}
+
+/// [`adam::FusedAdam`] updates every parameter bit for bit as burn's `Adam` of the same
+/// configuration, first step included, with and without gradient clipping: on an LSTM
+/// network (every parameter shape of the windowed models, whole gradients) and on the fused
+/// KFU filter (gradients that are views into the packed parameters' gradient).
+#[test]
+fn fused_adam_equals_burns_adam_bit_for_bit() {
+    let device = device();
+    for (seed, clip) in [(0u64, None), (1, Some(0.05f32))] {
+        let mut r = rng(seed, 13);
+        let arch = LstmArch(RecurrentLayers {
+            layers: vec![5, 4],
+            fc: vec![3],
+            activation: Activation::Relu,
+        });
+        let net = arch.build(2, 4, 3, &device).map(&mut Fill {
+            rng: &mut r,
+            scale: 0.5,
+        });
+        let xs: Vec<Tensor<3>> = (0..5)
+            .map(|_| tensor(uniform(&mut r, 3 * 4 * 2, 1.5), [3, 4, 2], &device))
+            .collect();
+        assert_adam_steps("LSTM", net, clip, |n, k| {
+            let y = arch.forward(n, xs[k as usize].clone());
+            (y.clone() * y).sum()
+        });
+        let cfg = KfuConfig {
+            layers: vec![4],
+            fc: vec![3],
+            ..KfuConfig::default()
+        };
+        let spec = kfu::Spec {
+            d: 2,
+            layers: cfg.layers.clone(),
+            fc: cfg.fc.clone(),
+            activation: cfg.activation,
+        };
+        let cell = KfuCell::new(&cfg, 2, &device).map(&mut Fill {
+            rng: &mut r,
+            scale: 0.5,
+        });
+        let zs: Vec<Tensor<3>> = (0..5)
+            .map(|_| tensor(uniform(&mut r, 3 * 5 * 2, 1.5), [3, 5, 2], &device))
+            .collect();
+        assert_adam_steps("KFU", cell, clip, |c, k| {
+            let run = c
+                .run_fused(zs[k as usize].clone(), &spec, 1.0, 0)
+                .expect("runs fused");
+            (run.priors.clone() * run.priors).sum()
+        });
     }
 }
