@@ -10,6 +10,7 @@ use crate::linalg::{
 use crate::model::{Observation, SigmaImages, Transition, validate_models};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
+use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 
 /// Merwe's scaled sigma points (`docs/papers.md` C.1 eq. 10-11): for a state of dimension `n`,
@@ -36,13 +37,14 @@ impl<T: RealField + Copy> MerweSigmaPoints<T> {
     /// The weights for a state of dimension `n`. Errors with
     /// [`KalmanError::DegenerateSigmaPoints`] when a parameter is not finite, `alpha <= 0`
     /// or `n + lambda = alpha^2 (n + kappa) <= 0` (the weights `1 / (2 (n + lambda))` would
-    /// be infinite or negative), and [`KalmanError::InvalidParameter`] for `n = 0`.
+    /// be infinite or negative), and [`trajpred_core::Error::InvalidParameter`] for `n = 0`.
     pub fn weights(&self, n: usize) -> Result<SigmaWeights<T>> {
         if n == 0 {
-            return Err(KalmanError::InvalidParameter {
+            return Err(CoreError::InvalidParameter {
                 name: "n",
-                reason: "the state dimension must be at least 1".into(),
-            });
+                reason: format!("the state dimension must be at least 1, got {n}"),
+            }
+            .into());
         }
         let nt = nalgebra::convert::<f64, T>(n as f64);
         let lambda = self.alpha * self.alpha * (nt + self.kappa) - nt;

@@ -4,6 +4,7 @@
 use crate::error::{KalmanError, Result};
 use nalgebra::allocator::Allocator;
 use nalgebra::{Const, DefaultAllocator, Dim, OMatrix, OVector, RealField};
+use trajpred_core::Error as CoreError;
 
 /// The lower Cholesky factor `L` (`A = L L^T`) of a symmetric positive definite matrix,
 /// computed in place by a plain Cholesky-Banachiewicz loop (faster than the general
@@ -201,7 +202,7 @@ where
 }
 
 /// The `L D L^T` factorisation of a symmetric positive definite matrix, or
-/// [`KalmanError::NotPositiveDefinite`] naming `what`.
+/// [`trajpred_core::Error::NotPositiveDefinite`] naming `what`.
 #[inline(always)]
 pub(crate) fn ldl<T, D>(m: OMatrix<T, D, D>, what: &'static str) -> Result<Ldl<T, D>>
 where
@@ -211,12 +212,12 @@ where
 {
     match Ldl::factor(m, T::zero()) {
         (f, true) => Ok(f),
-        _ => Err(KalmanError::NotPositiveDefinite { what }),
+        _ => Err(CoreError::NotPositiveDefinite { what }.into()),
     }
 }
 
 /// Cholesky factor of a symmetric positive definite matrix, or
-/// [`KalmanError::NotPositiveDefinite`] naming `what`.
+/// [`trajpred_core::Error::NotPositiveDefinite`] naming `what`.
 #[inline(always)]
 pub(crate) fn cholesky<T, D>(m: OMatrix<T, D, D>, what: &'static str) -> Result<Chol<T, D>>
 where
@@ -224,5 +225,5 @@ where
     D: Dim,
     DefaultAllocator: Allocator<D, D>,
 {
-    Chol::new(m).ok_or(KalmanError::NotPositiveDefinite { what })
+    Chol::new(m).ok_or(KalmanError::Core(CoreError::NotPositiveDefinite { what }))
 }

@@ -80,7 +80,7 @@ fn sparse_error(e: trajpred_sparse::Error) -> Error {
 }
 
 fn kalman_error(e: trajpred_kalman::KalmanError) -> Error {
-    Error::method("gskf", e)
+    Error::from_crate("gskf", e)
 }
 
 /// The training series of axis `a`: one per trajectory long enough for the GSC designs.

@@ -119,7 +119,7 @@ pub struct ImmPredictor {
 type Mode = Box<dyn Filter<f64, U5, U2>>;
 
 fn kalman(e: KalmanError) -> Error {
-    Error::method("imm", e)
+    Error::from_crate("imm", e)
 }
 
 /// The IMM for a step of `dt` seconds under `p`.

@@ -142,7 +142,7 @@ impl Predictor for ParticlePredictor {
     fn forecast_times(&self, history: &Trajectory, times: &[f64]) -> Result<Forecast> {
         check_forecast_args(history, times.len(), self.min_history())?;
         let method = self.method();
-        let kalman = |e: trajpred_kalman::KalmanError| Error::method(method, e);
+        let kalman = |e: trajpred_kalman::KalmanError| Error::from_crate(method, e);
         let particle = |e: trajpred_particle::ParticleError| Error::method(method, e);
         let p = &self.params;
         let d = history.dim();
