@@ -76,7 +76,7 @@ impl GskfParams {
 }
 
 fn sparse_error(e: trajpred_sparse::Error) -> Error {
-    Error::method("gsc", e)
+    Error::from_crate("gsc", e)
 }
 
 fn kalman_error(e: trajpred_kalman::KalmanError) -> Error {
