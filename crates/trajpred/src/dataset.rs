@@ -136,7 +136,7 @@ impl Dataset {
 }
 
 fn data_error(e: trajpred_data::Error) -> Error {
-    Error::method("data", e)
+    Error::from_crate("data", e)
 }
 
 /// What [`load_tracks`] read.
