@@ -8,7 +8,7 @@
 
 use super::bridge;
 use super::{Mat, Real, add_column_sums, cell_backward, cell_forward, gemm};
-use crate::error::{NeuralError, Result};
+use crate::error::{CoreError, NeuralError, Result};
 use burn::backend::flex::FlexTensor;
 use burn::tensor::Tensor;
 
@@ -60,11 +60,11 @@ fn check_len<T>(v: &[T], n: usize, what: &'static str) -> Result<()> {
     if v.len() == n {
         Ok(())
     } else {
-        Err(NeuralError::DimensionMismatch {
+        Err(NeuralError::Core(CoreError::DimensionMismatch {
             what,
             expected: n,
             got: v.len(),
-        })
+        }))
     }
 }
 
