@@ -143,7 +143,7 @@ impl Predictor for ParticlePredictor {
         check_forecast_args(history, times.len(), self.min_history())?;
         let method = self.method();
         let kalman = |e: trajpred_kalman::KalmanError| Error::from_crate(method, e);
-        let particle = |e: trajpred_particle::ParticleError| Error::method(method, e);
+        let particle = |e: trajpred_particle::ParticleError| Error::from_crate(method, e);
         let p = &self.params;
         let d = history.dim();
         let n = 2 * d;
