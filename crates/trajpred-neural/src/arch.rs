@@ -5,7 +5,7 @@
 //! multi-step outputs `[batch, T * features]`.
 
 use crate::config::{Activation, TrainConfig};
-use crate::error::{CoreError, Result};
+use crate::error::{CoreError, NeuralError, Result};
 use burn::module::Module;
 use burn::nn::{Linear, LinearConfig, Rnn, RnnConfig};
 use burn::tensor::activation::{relu, sigmoid, tanh};
@@ -54,27 +54,24 @@ pub const MAX_LAYERS: usize = 16;
 
 pub(crate) fn check_sizes(name: &'static str, sizes: &[usize], need_one: bool) -> Result<()> {
     if sizes.len() > MAX_LAYERS || sizes.iter().any(|&w| w > MAX_LAYER_WIDTH) {
-        return Err(CoreError::InvalidParameter {
+        return Err(NeuralError::Core(CoreError::InvalidParameter {
             name,
             reason: format!(
                 "at most {MAX_LAYERS} layers of at most {MAX_LAYER_WIDTH} units (got {sizes:?})"
             ),
-        }
-        .into());
+        }));
     }
     if need_one && sizes.is_empty() {
-        return Err(CoreError::InvalidParameter {
+        return Err(NeuralError::Core(CoreError::InvalidParameter {
             name,
             reason: format!("needs at least one layer, got {sizes:?}"),
-        }
-        .into());
+        }));
     }
     if sizes.contains(&0) {
-        return Err(CoreError::InvalidParameter {
+        return Err(NeuralError::Core(CoreError::InvalidParameter {
             name,
             reason: format!("layer sizes must be at least 1, got {sizes:?}"),
-        }
-        .into());
+        }));
     }
     Ok(())
 }

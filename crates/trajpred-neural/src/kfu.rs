@@ -424,29 +424,26 @@ impl KfuLstmNet {
         progress: &mut dyn FnMut(&EpochReport),
     ) -> Result<&TrainReport> {
         if observed.len() != truth.len() {
-            return Err(CoreError::DimensionMismatch {
+            return Err(NeuralError::Core(CoreError::DimensionMismatch {
                 what: "number of truth trajectories",
                 expected: observed.len(),
                 got: truth.len(),
-            }
-            .into());
+            }));
         }
         for (o, t) in observed.iter().zip(truth) {
             if o.len() != t.len() {
-                return Err(CoreError::DimensionMismatch {
+                return Err(NeuralError::Core(CoreError::DimensionMismatch {
                     what: "truth trajectory length",
                     expected: o.len(),
                     got: t.len(),
-                }
-                .into());
+                }));
             }
             if o.dim() != t.dim() {
-                return Err(CoreError::DimensionMismatch {
+                return Err(NeuralError::Core(CoreError::DimensionMismatch {
                     what: "truth trajectory axes",
                     expected: o.dim(),
                     got: t.dim(),
-                }
-                .into());
+                }));
             }
         }
         self.fit_inner(observed, Some(truth), progress)
@@ -471,12 +468,11 @@ impl KfuLstmNet {
         let dim = common_dim(observed)?;
         let shortest = observed.iter().map(Trajectory::len).min().unwrap_or(0);
         if shortest < 3 {
-            return Err(CoreError::TooShort {
+            return Err(NeuralError::Core(CoreError::TooShort {
                 what: "shortest training trajectory (in points)",
                 needed: 3,
                 got: shortest,
-            }
-            .into());
+            }));
         }
         let series: Vec<Vec<&[f64]>> = observed.iter().map(series_of).collect();
         let scaler = Standardizer::fit(&series, dim);
@@ -582,30 +578,26 @@ impl KfuLstmNet {
         let (f, cell) = self.cell()?;
         let dim = f.dim;
         if history.is_empty() {
-            return Err(CoreError::TooShort {
+            return Err(NeuralError::Core(CoreError::TooShort {
                 what: "history (in points)",
                 needed: 1,
                 got: 0,
-            }
-            .into());
+            }));
         }
         let c = history.len().min(self.config.seq_len);
         let recent = &history[history.len() - c..];
         let mut z = Vec::with_capacity(c * dim);
         for (i, p) in recent.iter().enumerate() {
             if p.len() != dim {
-                return Err(CoreError::DimensionMismatch {
+                return Err(NeuralError::Core(CoreError::DimensionMismatch {
                     what: "history point axes",
                     expected: dim,
                     got: p.len(),
-                }
-                .into());
+                }));
             }
-            check_finite("history", p).map_err(|_| {
-                NeuralError::Core(CoreError::NonFinite {
-                    what: "history",
-                    index: history.len() - c + i,
-                })
+            check_finite("history", p).map_err(|_| CoreError::NonFinite {
+                what: "history",
+                index: history.len() - c + i,
             })?;
             z.extend(
                 p.iter()
@@ -623,11 +615,10 @@ impl KfuLstmNet {
                 .map(|k| f.scaler.inverse(k, f64::from(v[k])))
                 .collect();
             if p.iter().any(|x| !x.is_finite()) {
-                return Err(CoreError::NonFinite {
+                return Err(NeuralError::Core(CoreError::NonFinite {
                     what: "network output",
                     index: s,
-                }
-                .into());
+                }));
             }
             out.push(p);
         }
@@ -642,21 +633,19 @@ impl KfuLstmNet {
         let (f, cell) = self.cell()?;
         let dim = f.dim;
         if observed.dim() != dim {
-            return Err(CoreError::DimensionMismatch {
+            return Err(NeuralError::Core(CoreError::DimensionMismatch {
                 what: "trajectory axes",
                 expected: dim,
                 got: observed.dim(),
-            }
-            .into());
+            }));
         }
         let n = observed.len();
         if n < 2 {
-            return Err(CoreError::TooShort {
+            return Err(NeuralError::Core(CoreError::TooShort {
                 what: "trajectory (in points)",
                 needed: 2,
                 got: n,
-            }
-            .into());
+            }));
         }
         let l = self.config.seq_len;
         let spec = self.spec(dim);
@@ -704,11 +693,10 @@ impl KfuLstmNet {
             }
         }
         if let Some(i) = out.iter().position(|p| p.iter().any(|x| !x.is_finite())) {
-            return Err(CoreError::NonFinite {
+            return Err(NeuralError::Core(CoreError::NonFinite {
                 what: "network output",
                 index: i,
-            }
-            .into());
+            }));
         }
         Ok(out)
     }

@@ -267,12 +267,11 @@ pub(crate) fn common_dim(train: &[Trajectory]) -> Result<usize> {
             what: "no training trajectories",
         })?;
     if let Some(t) = train.iter().find(|t| t.dim() != dim) {
-        return Err(CoreError::DimensionMismatch {
+        return Err(NeuralError::Core(CoreError::DimensionMismatch {
             what: "training trajectory axes",
             expected: dim,
             got: t.dim(),
-        }
-        .into());
+        }));
     }
     Ok(dim)
 }
@@ -280,7 +279,7 @@ pub(crate) fn common_dim(train: &[Trajectory]) -> Result<usize> {
 /// Checks that every value of a raw series is finite.
 pub(crate) fn check_finite(what: &'static str, values: &[f64]) -> Result<()> {
     match values.iter().position(|v| !v.is_finite()) {
-        Some(index) => Err(CoreError::NonFinite { what, index }.into()),
+        Some(index) => Err(NeuralError::Core(CoreError::NonFinite { what, index })),
         None => Ok(()),
     }
 }

@@ -44,11 +44,10 @@ impl WindowConfig {
     pub fn validate(&self) -> Result<()> {
         for (name, v) in [("window", self.window), ("horizon", self.horizon)] {
             if !(1..=MAX_WINDOW).contains(&v) {
-                return Err(CoreError::InvalidParameter {
+                return Err(NeuralError::Core(CoreError::InvalidParameter {
                     name,
                     reason: format!("must lie in 1..={MAX_WINDOW}, got {v}"),
-                }
-                .into());
+                }));
             }
         }
         Ok(())
@@ -246,21 +245,19 @@ impl<A: Architecture> WindowNet<A> {
         progress: &mut dyn FnMut(&EpochReport),
     ) -> Result<&[TrainReport]> {
         if inputs.len() != targets.len() {
-            return Err(CoreError::DimensionMismatch {
+            return Err(NeuralError::Core(CoreError::DimensionMismatch {
                 what: "number of target trajectories",
                 expected: inputs.len(),
                 got: targets.len(),
-            }
-            .into());
+            }));
         }
         for (i, t) in inputs.iter().zip(targets) {
             if i.len() != t.len() || i.dim() != t.dim() {
-                return Err(CoreError::DimensionMismatch {
+                return Err(NeuralError::Core(CoreError::DimensionMismatch {
                     what: "target trajectory length x axes",
                     expected: i.len() * i.dim(),
                     got: t.len() * t.dim(),
-                }
-                .into());
+                }));
             }
         }
         self.fit_inner(inputs, Some(targets), progress)
@@ -276,12 +273,11 @@ impl<A: Architecture> WindowNet<A> {
         let (m, h) = (self.layout.window, self.layout.horizon);
         let longest = train.iter().map(Trajectory::len).max().unwrap_or(0);
         if longest < m + h {
-            return Err(CoreError::TooShort {
+            return Err(NeuralError::Core(CoreError::TooShort {
                 what: "longest training trajectory (in points)",
                 needed: m + h,
                 got: longest,
-            }
-            .into());
+            }));
         }
         let series: Vec<Vec<&[f64]>> = train
             .iter()
@@ -457,27 +453,23 @@ impl<A: Architecture> WindowNet<A> {
         let (fitted, nets) = self.nets()?;
         let (m, h, dim) = (self.layout.window, self.layout.horizon, fitted.dim);
         if window.len() != m {
-            return Err(CoreError::DimensionMismatch {
+            return Err(NeuralError::Core(CoreError::DimensionMismatch {
                 what: "window length",
                 expected: m,
                 got: window.len(),
-            }
-            .into());
+            }));
         }
         for (i, p) in window.iter().enumerate() {
             if p.len() != dim {
-                return Err(CoreError::DimensionMismatch {
+                return Err(NeuralError::Core(CoreError::DimensionMismatch {
                     what: "window point axes",
                     expected: dim,
                     got: p.len(),
-                }
-                .into());
+                }));
             }
-            check_finite("window", p).map_err(|_| {
-                NeuralError::Core(CoreError::NonFinite {
-                    what: "window",
-                    index: i,
-                })
+            check_finite("window", p).map_err(|_| CoreError::NonFinite {
+                what: "window",
+                index: i,
             })?;
         }
         let device = device();
@@ -510,11 +502,10 @@ impl<A: Architecture> WindowNet<A> {
             }
         }
         if let Some(i) = outp.iter().position(|p| p.iter().any(|v| !v.is_finite())) {
-            return Err(CoreError::NonFinite {
+            return Err(NeuralError::Core(CoreError::NonFinite {
                 what: "network output",
                 index: i,
-            }
-            .into());
+            }));
         }
         Ok(outp)
     }
@@ -524,12 +515,11 @@ impl<A: Architecture> WindowNet<A> {
     pub fn predict_series(&self, history: &[Vec<f64>], horizon: usize) -> Result<Vec<Vec<f64>>> {
         let m = self.layout.window;
         if history.len() < m {
-            return Err(CoreError::TooShort {
+            return Err(NeuralError::Core(CoreError::TooShort {
                 what: "history (in points)",
                 needed: m,
                 got: history.len(),
-            }
-            .into());
+            }));
         }
         let mut window: Vec<Vec<f64>> = history[history.len() - m..].to_vec();
         let mut out = Vec::with_capacity(horizon);
