@@ -50,10 +50,10 @@ impl Default for GskfParams {
 impl GskfParams {
     fn validate(&self) -> Result<()> {
         if self.window == 0 {
-            return Err(invalid("window", "m must be at least 1"));
+            return Err(invalid("window", "m must be at least 1, got 0"));
         }
         if self.horizons == 0 {
-            return Err(invalid("horizons", "T must be at least 1"));
+            return Err(invalid("horizons", "T must be at least 1, got 0"));
         }
         if let Some(q) = self.q
             && !(q.is_finite() && q >= 0.0)
@@ -68,7 +68,10 @@ impl GskfParams {
         {
             return Err(invalid(
                 "q_grid",
-                "needs at least one finite, non-negative multiplier",
+                format!(
+                    "needs at least one multiplier, each finite and non-negative, got {:?}",
+                    self.q_grid
+                ),
             ));
         }
         Ok(())

@@ -89,7 +89,10 @@ impl ImmParams {
         if self.fit_tracks < 4 || self.fit_points < 3 {
             return Err(invalid(
                 "fit_tracks",
-                "the fit needs at least 4 tracks of at least 3 points",
+                format!(
+                    "the fit needs at least 4 tracks of at least 3 points, got {} tracks of {} points",
+                    self.fit_tracks, self.fit_points
+                ),
             ));
         }
         Ok(())

@@ -83,7 +83,10 @@ impl KfTimeParams {
         if self.fit_tracks == 0 || self.fit_points < 3 {
             return Err(invalid(
                 "fit_tracks",
-                "the fit needs at least one track of at least 3 points",
+                format!(
+                    "the fit needs at least one track of at least 3 points, got {} tracks of {} points",
+                    self.fit_tracks, self.fit_points
+                ),
             ));
         }
         Ok(())

@@ -78,7 +78,7 @@ impl ParticlePredictor {
     /// A validated predictor.
     pub fn new(params: ParticleParams) -> Result<Self> {
         if params.particles == 0 {
-            return Err(invalid("particles", "need at least one particle"));
+            return Err(invalid("particles", "need at least one particle, got 0"));
         }
         for (name, v) in [
             ("accel_density", params.accel_density),
