@@ -153,7 +153,7 @@ impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
             }
         }
         let c = self.weights.lambda + nalgebra::convert::<f64, T>(l as f64);
-        // the augmented covariance: Q may be singular, so factor with the PSD jitter
+        // the augmented covariance: Q may be singular, so a semi-definite square root
         let la = crate::sampling::covariance_sqrt(&(pa * c), "augmented covariance")?;
         let d = state.mean.shape_generic().0;
         let md = M::from_usize(m);

@@ -663,17 +663,6 @@ where
     Ok(update)
 }
 
-/// `ln N(y; 0, S)` from the `L D L^T` factorisation of `S`.
-#[inline(always)]
-pub(crate) fn gaussian_log_likelihood<T, M>(s: &Ldl<T, M>, y: &OVector<T, M>) -> T
-where
-    T: RealField + Copy,
-    M: Dim,
-    DefaultAllocator: Allocator<M> + Allocator<M, M>,
-{
-    log_likelihood_from(y.nrows(), s.log_det(), s.quadratic_form(y))
-}
-
 /// Validates a state against the transition's dimension (shared by every filter's steps).
 pub(crate) fn validate_state<T, D>(
     state: &Gaussian<T, D>,

@@ -28,6 +28,12 @@ where
     }
 }
 
+/// `v` as `f64` (NaN if it cannot be represented, which the callers reject as non-finite).
+#[inline(always)]
+pub(crate) fn to_f64<T: RealField + Copy>(v: T) -> f64 {
+    nalgebra::try_convert::<T, f64>(v).unwrap_or(f64::NAN)
+}
+
 /// `true` when no element of `m` is NaN or infinite: one pass without early exit, so the
 /// compiler vectorises it (the index of a bad value is looked up only on failure).
 #[inline(always)]

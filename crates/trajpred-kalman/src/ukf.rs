@@ -5,7 +5,7 @@ use crate::alloc::FilterAllocator;
 use crate::error::{KalmanError, Result};
 use crate::filter::{Filter, InputChecks, PredictionWithCross, Smoother, Update, validate_state};
 use crate::linalg::{
-    check_dim, check_finite, cholesky, ldl, mul, mul_tr_sym_plus, mul_vec, symmetrise,
+    check_dim, check_finite, cholesky, ldl, mul, mul_tr_sym_plus, mul_vec, symmetrise, to_f64,
 };
 use crate::model::{Observation, SigmaImages, Transition, validate_models};
 use nalgebra::allocator::Allocator;
@@ -108,10 +108,6 @@ impl<T: RealField + Copy> Default for MerweSigmaPoints<T> {
             kappa: T::zero(),
         }
     }
-}
-
-fn to_f64<T: RealField + Copy>(v: T) -> f64 {
-    nalgebra::try_convert::<T, f64>(v).unwrap_or(f64::NAN)
 }
 
 /// The weights of Merwe's sigma points for one state dimension.

@@ -5,7 +5,6 @@
 pub mod cloud;
 pub mod driver;
 pub mod error;
-mod gauss;
 pub mod mkpf;
 pub mod pf;
 pub mod resample;

@@ -2,9 +2,8 @@
 //! [`Mkpf`](crate::Mkpf) ([`ParticleFiltering`]), its configuration ([`PfConfig`]) and the
 //! per-step summary ([`StepSummary`]).
 
-use crate::cloud::ParticleCloud;
+use crate::cloud::{ParticleCloud, first_non_finite};
 use crate::error::Result;
-use crate::gauss::{Density, first_non_finite, psd_factor, push_normals, shifted};
 use crate::resample::{Resampler, Resampling};
 use crate::weights::{ResamplePolicy, effective_sample_size_log, normalize_log_weights};
 use nalgebra::allocator::Allocator;
@@ -15,6 +14,7 @@ use std::marker::PhantomData;
 use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 use trajpred_kalman::driver::scan;
+use trajpred_kalman::sampling::{ZeroMeanGaussian, covariance_sqrt, draw, push_standard_normals};
 use trajpred_kalman::{Observation, Transition};
 
 /// Minimum particles per rayon task: below this the work per particle of the bootstrap
@@ -126,7 +126,7 @@ where
         check_observation(z, m)?;
     }
     let mut noise: Vec<T> = Vec::new();
-    push_normals(rng, cloud.len() * cloud.dim(), &mut noise);
+    push_standard_normals(rng, cloud.len() * cloud.dim(), &mut noise);
     Ok(noise)
 }
 
@@ -159,7 +159,7 @@ where
 /// `ln p(z | x) = ln N(residual(z, h(x)); 0, R)`.
 pub(crate) fn log_likelihood<T, D, M, Ob>(
     observation: &Ob,
-    density: &Density<T, M>,
+    density: &ZeroMeanGaussian<T, M>,
     x: &OVector<T, D>,
     z: &OVector<T, M>,
 ) -> Result<f64>
@@ -204,7 +204,7 @@ where
         }
         .into());
     }
-    let out = shifted(&fx, q_factor, e);
+    let out = draw(&fx, q_factor, e.iter().copied());
     if let Some(index) = first_non_finite(&out) {
         return Err(CoreError::NonFinite {
             what: "propagated particle",
@@ -237,7 +237,7 @@ where
     scan(0..steps, |prev: Option<&ParticleCloud<T, D>>, _| {
         let prev = prev.unwrap_or(cloud);
         noise.clear();
-        push_normals(rng, prev.len() * n, &mut noise);
+        push_standard_normals(rng, prev.len() * n, &mut noise);
         let particles: Vec<OVector<T, D>> = prev
             .particles()
             .par_iter()
@@ -348,7 +348,7 @@ where
     cloud: ParticleCloud<T, D>,
     config: PfConfig,
     q_factor: OMatrix<T, D, D>,
-    likelihood: Density<T, M>,
+    likelihood: ZeroMeanGaussian<T, M>,
     _m: PhantomData<fn() -> M>,
 }
 
@@ -374,8 +374,8 @@ where
             }
             .into());
         }
-        let q_factor = psd_factor(transition.process_noise(), "Q")?;
-        let likelihood = Density::new(observation.observation_noise(), "R")?;
+        let q_factor = covariance_sqrt(transition.process_noise(), "Q")?;
+        let likelihood = ZeroMeanGaussian::new(observation.observation_noise(), "R")?;
         Ok(ParticleFilter {
             transition,
             observation,
