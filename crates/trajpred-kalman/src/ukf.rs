@@ -10,6 +10,7 @@ use crate::linalg::{
 use crate::model::{Observation, SigmaImages, Transition, validate_models};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
+use std::marker::PhantomData;
 use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 
@@ -298,18 +299,62 @@ const UKF_CHECKS: InputChecks = InputChecks::Cheap;
 ///
 /// The weights are computed once, at construction, for the transition's state size; a
 /// parameter set with degenerate weights is rejected there.
+pub type Ukf<T, Tr, Ob> = SigmaPointFilter<T, Tr, Ob, AdditiveNoise>;
+
+/// An unscented filter: the models, Merwe's sigma-point parameters and their weights for the
+/// space `S` the sigma points are drawn in. [`Ukf`] draws them in the state space
+/// ([`AdditiveNoise`]), [`AugmentedUkf`](crate::AugmentedUkf) in the space of the state and
+/// both noises ([`AugmentedNoise`]); the two differ only in their steps.
 #[derive(Debug, Clone)]
-pub struct Ukf<T, Tr, Ob> {
-    transition: Tr,
-    observation: Ob,
-    points: MerweSigmaPoints<T>,
-    weights: SigmaWeights<T>,
+pub struct SigmaPointFilter<T, Tr, Ob, S> {
+    pub(crate) transition: Tr,
+    pub(crate) observation: Ob,
+    pub(crate) points: MerweSigmaPoints<T>,
+    pub(crate) weights: SigmaWeights<T>,
+    space: PhantomData<fn() -> S>,
 }
 
-impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
-    /// A UKF from a transition (`f`, `Q`), an observation (`h`, `R`) and sigma-point
-    /// parameters. Errors: [`KalmanError::DegenerateSigmaPoints`], and the model checks of
-    /// `Q` and `R`.
+/// The space an unscented filter draws its sigma points in: its dimension for a state of
+/// size `n` and an observation of size `m`. Implemented by [`AdditiveNoise`] and
+/// [`AugmentedNoise`] only.
+pub trait SigmaSpace: sealed::Sealed {
+    /// The number of dimensions the sigma points have (the weights are for it).
+    fn dim(n: usize, m: usize) -> usize;
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for super::AdditiveNoise {}
+    impl Sealed for super::AugmentedNoise {}
+}
+
+/// The state space, `n` dimensions: the noise covariances are added to the moments
+/// ([`Ukf`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AdditiveNoise;
+
+/// The state and both noises, `2n + m` dimensions: the noise is inside the points
+/// ([`AugmentedUkf`](crate::AugmentedUkf)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AugmentedNoise;
+
+impl SigmaSpace for AdditiveNoise {
+    fn dim(n: usize, _m: usize) -> usize {
+        n
+    }
+}
+
+impl SigmaSpace for AugmentedNoise {
+    fn dim(n: usize, m: usize) -> usize {
+        2 * n + m
+    }
+}
+
+impl<T: RealField + Copy, Tr, Ob, S: SigmaSpace> SigmaPointFilter<T, Tr, Ob, S> {
+    /// A filter from a transition (`f`, `Q`), an observation (`h`, `R`) and sigma-point
+    /// parameters, the weights computed once for the dimension of `S` (`n` for [`Ukf`],
+    /// `2n + m` for [`AugmentedUkf`](crate::AugmentedUkf)). Errors:
+    /// [`KalmanError::DegenerateSigmaPoints`], and the model checks of `Q` and `R`.
     pub fn new<D: Dim, M: Dim>(
         transition: Tr,
         observation: Ob,
@@ -321,12 +366,14 @@ impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
         DefaultAllocator: FilterAllocator<D, M>,
     {
         validate_models(&transition, &observation)?;
-        let weights = points.weights(transition.state_dim())?;
-        Ok(Ukf {
+        let dim = S::dim(transition.state_dim(), observation.observation_dim());
+        let weights = points.weights(dim)?;
+        Ok(SigmaPointFilter {
             transition,
             observation,
             points,
             weights,
+            space: PhantomData,
         })
     }
 
@@ -335,7 +382,7 @@ impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
         &self.points
     }
 
-    /// The sigma-point weights for this filter's state size.
+    /// The sigma-point weights, for the dimension of `S`.
     pub fn weights(&self) -> &SigmaWeights<T> {
         &self.weights
     }
