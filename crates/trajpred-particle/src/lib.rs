@@ -2,6 +2,7 @@
 #![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 
+mod alloc;
 pub mod cloud;
 pub mod driver;
 pub mod error;
@@ -22,6 +23,7 @@ pub use trajpred_kalman::{
     ObservationJacobian, RangeBearing, Transition, TransitionJacobian,
 };
 
+pub use alloc::ParticleAllocator;
 pub use cloud::ParticleCloud;
 pub use error::{ParticleError, Result};
 pub use mkpf::{EkfStage, Mkpf, ParticlePrior, UkfVariant};

@@ -2,6 +2,7 @@
 //! carries a mean and a covariance and proposes from a UKF step followed by an EKF step, both the
 //! Kalman crate's own (`trajpred_kalman::Ukf`, `trajpred_kalman::Ekf`).
 
+use crate::alloc::ParticleAllocator;
 use crate::cloud::{ParticleCloud, first_non_finite};
 use crate::error::Result;
 use crate::pf::{
@@ -15,7 +16,6 @@ use rayon::prelude::*;
 use std::marker::PhantomData;
 use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
-use trajpred_kalman::FilterAllocator;
 use trajpred_kalman::sampling::{ZeroMeanGaussian, covariance_sqrt, draw};
 use trajpred_kalman::{
     AugmentedUkf, Ekf, Filter, KalmanError, MerweSigmaPoints, NoisyObservation, NoisyTransition,
@@ -221,11 +221,7 @@ impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> Mkpf<T, D, M, Tr, Ob>
 where
     Tr: TransitionJacobian<T, D> + NoisyTransition<T, D> + Sync,
     Ob: ObservationJacobian<T, D, M> + NoisyObservation<T, D, M> + Sync,
-    DefaultAllocator: FilterAllocator<D, M>,
-    OVector<T, D>: Send + Sync,
-    OMatrix<T, D, D>: Send + Sync,
-    OVector<T, M>: Sync,
-    OMatrix<T, M, M>: Send + Sync,
+    DefaultAllocator: ParticleAllocator<T, D, M>,
 {
     /// An MKPF over `cloud`, every particle starting with the covariance `initial_covariance`
     /// (the paper's `P_0^i = P_0`), with the sigma-point parameters `points` (the paper:
@@ -535,11 +531,7 @@ impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> ParticleFiltering<T, D, M>
 where
     Tr: TransitionJacobian<T, D> + NoisyTransition<T, D> + Sync,
     Ob: ObservationJacobian<T, D, M> + NoisyObservation<T, D, M> + Sync,
-    DefaultAllocator: FilterAllocator<D, M>,
-    OVector<T, D>: Send + Sync,
-    OMatrix<T, D, D>: Send + Sync,
-    OVector<T, M>: Sync,
-    OMatrix<T, M, M>: Send + Sync,
+    DefaultAllocator: ParticleAllocator<T, D, M>,
 {
     fn step<R: Rng + ?Sized>(
         &mut self,

@@ -2,6 +2,7 @@
 //! [`Mkpf`](crate::Mkpf) ([`ParticleFiltering`]), its configuration ([`PfConfig`]) and the
 //! per-step summary ([`StepSummary`]).
 
+use crate::alloc::ParticleAllocator;
 use crate::cloud::{ParticleCloud, first_non_finite};
 use crate::error::Result;
 use crate::resample::{Resampler, Resampling};
@@ -356,9 +357,7 @@ impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> ParticleFilter<T, D, M, Tr, Ob
 where
     Tr: Transition<T, D> + Sync,
     Ob: Observation<T, D, M> + Sync,
-    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M>,
-    OVector<T, D>: Send + Sync,
-    OMatrix<T, D, D>: Send + Sync,
+    DefaultAllocator: ParticleAllocator<T, D, M>,
 {
     /// A filter over `cloud` with the transition (`f`, `Q` positive semi-definite) and the
     /// observation (`h`, `R` positive definite). Errors:
@@ -437,11 +436,7 @@ impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> ParticleFiltering<T, D, M>
 where
     Tr: Transition<T, D> + Sync,
     Ob: Observation<T, D, M> + Sync,
-    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M>,
-    OVector<T, D>: Send + Sync,
-    OMatrix<T, D, D>: Send + Sync,
-    OVector<T, M>: Sync,
-    OMatrix<T, M, M>: Send + Sync,
+    DefaultAllocator: ParticleAllocator<T, D, M>,
 {
     fn step<R: Rng + ?Sized>(
         &mut self,
