@@ -77,10 +77,14 @@ fn dimension_mismatches() {
             ..
         }))
     ));
-    // an innovation whose S does not match its residual
+    // an innovation whose S does not match its residual (the core Gaussian's check)
     assert!(matches!(
         Innovation::new(DVector::<f64>::zeros(2), DMatrix::identity(3, 3)),
-        Err(KalmanError::Core(CoreError::DimensionMismatch { .. }))
+        Err(CoreError::DimensionMismatch {
+            expected: 2,
+            got: 3,
+            ..
+        })
     ));
     // range-bearing indices beyond the state
     let rb = RangeBearing::new(Vector2::new(0.0, 0.0), 0, 7, 1.0, 0.1).unwrap();
@@ -191,9 +195,22 @@ fn not_positive_definite_p_q_r_s() {
             what: "R"
         }))
     ));
-    // S: an innovation covariance that is not positive definite
+    // S: an innovation covariance that is not positive definite; a negative variance is
+    // refused by the Gaussian, an indefinite symmetric S by the IKF that solves with it
     assert!(matches!(
         Innovation::new(Vector1::new(1.0), Matrix1::new(-1.0)),
+        Err(CoreError::NotPositiveDefinite { what: "covariance" })
+    ));
+    let (tr2, ob2) = (
+        LinearTransition::new(Matrix2::identity(), Matrix2::identity()).unwrap(),
+        LinearObservation::new(Matrix2::identity(), Matrix2::identity()).unwrap(),
+    );
+    let indefinite = Innovation::new(Vector2::new(1.0, 0.0), Matrix2::new(1.0, 2.0, 2.0, 1.0));
+    let prior2 = Gaussian::new(Vector2::zeros(), Matrix2::identity()).unwrap();
+    assert!(matches!(
+        Ikf::new(&tr2, &ob2)
+            .unwrap()
+            .correct(&prior2, &indefinite.unwrap()),
         Err(KalmanError::Core(CoreError::NotPositiveDefinite {
             what: "S"
         }))

@@ -168,7 +168,7 @@ impl AxisFilter {
                 mean: DVector::zeros(t),
                 covariance: p_prior.clone(),
             };
-            let innov = Innovation::new(DVector::zeros(t), s.clone()).map_err(kalman_error)?;
+            let innov = Innovation::new(DVector::zeros(t), s.clone())?;
             let next = ikf
                 .correct(&prior, &innov)
                 .map_err(kalman_error)?
@@ -201,7 +201,7 @@ impl AxisFilter {
             covariance: self.p_prior.clone(),
         };
         let v = residuals(&self.gsc, x, i)?;
-        let innov = Innovation::new(v, self.s.clone()).map_err(kalman_error)?;
+        let innov = Innovation::new(v, self.s.clone())?;
         self.ikf.correct(&prior, &innov).map_err(kalman_error)
     }
 }
