@@ -216,5 +216,47 @@ pub trait CrateError: std::error::Error + Send + Sync + Sized + 'static {
     fn split_core(self) -> std::result::Result<Error, Self>;
 }
 
+/// The convention's conversions for a crate's error enum `$error` whose shared variant is
+/// `Core(trajpred_core::Error)`: [`CrateError`], and `From<$error>` for [`Error`] (a shared
+/// variant as itself, the crate's own variants wrapped in [`Error::Method`] naming `$name`).
+///
+/// ```
+/// use trajpred_core::Error;
+/// #[derive(Debug, thiserror::Error)]
+/// enum MyError {
+///     #[error(transparent)]
+///     Core(#[from] Error),
+///     #[error("diverged")]
+///     Diverged,
+/// }
+/// trajpred_core::crate_error!(MyError, "my-crate");
+/// let e: Error = MyError::Core(Error::Empty { what: "history" }).into();
+/// assert!(matches!(e, Error::Empty { what: "history" }));
+/// assert_eq!(Error::from(MyError::Diverged).to_string(), "my-crate: diverged");
+/// ```
+#[macro_export]
+macro_rules! crate_error {
+    ($error:ident, $name:literal) => {
+        impl $crate::CrateError for $error {
+            fn split_core(self) -> ::std::result::Result<$crate::Error, Self> {
+                match self {
+                    $error::Core(e) => Ok(e),
+                    own => Err(own),
+                }
+            }
+        }
+
+        #[doc = concat!(
+                    "A shared variant comes back as the core error itself, the others as ",
+                    "`trajpred_core::Error::Method` naming `", $name, "`."
+                )]
+        impl From<$error> for $crate::Error {
+            fn from(e: $error) -> Self {
+                $crate::Error::from_crate($name, e)
+            }
+        }
+    };
+}
+
 /// `Result` with [`enum@Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;

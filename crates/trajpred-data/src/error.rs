@@ -2,7 +2,6 @@
 //! the 1-based line (or JSON record) where it happened.
 
 use thiserror::Error;
-use trajpred_core::CrateError;
 
 /// Everything that can go wrong while loading, converting or generating trajectories.
 ///
@@ -98,23 +97,6 @@ impl Error {
     }
 }
 
-impl CrateError for Error {
-    fn split_core(self) -> std::result::Result<trajpred_core::Error, Self> {
-        match self {
-            Error::Core(e) => Ok(e),
-            own => Err(own),
-        }
-    }
-}
-
-/// A shared variant comes back as the core error itself, the loaders' own variants as
-/// [`trajpred_core::Error::Method`] naming `trajpred-data`.
-impl From<Error> for trajpred_core::Error {
-    fn from(e: Error) -> Self {
-        trajpred_core::Error::from_crate("trajpred-data", e)
-    }
-}
-
 /// A limit crossed inside a reader, carried out through `std::io::Error` (see [`Error::io`]).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct LimitHit {
@@ -151,3 +133,5 @@ impl std::fmt::Display for LimitHit {
 }
 
 impl std::error::Error for LimitHit {}
+
+trajpred_core::crate_error!(Error, "trajpred-data");

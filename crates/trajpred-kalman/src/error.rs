@@ -1,7 +1,6 @@
 //! The crate's error type, [`KalmanError`].
 
 use thiserror::Error;
-use trajpred_core::CrateError;
 
 /// Everything that can go wrong in `trajpred-kalman`. Numerical failure is reported here,
 /// never through a panic or a NaN in the output.
@@ -49,19 +48,4 @@ pub enum KalmanError {
 /// `Result` with [`KalmanError`].
 pub type Result<T, E = KalmanError> = std::result::Result<T, E>;
 
-impl CrateError for KalmanError {
-    fn split_core(self) -> std::result::Result<trajpred_core::Error, Self> {
-        match self {
-            KalmanError::Core(e) => Ok(e),
-            own => Err(own),
-        }
-    }
-}
-
-/// A shared variant comes back as the core error itself, the filters' own variants as
-/// [`trajpred_core::Error::Method`] naming `trajpred-kalman`.
-impl From<KalmanError> for trajpred_core::Error {
-    fn from(e: KalmanError) -> Self {
-        trajpred_core::Error::from_crate("trajpred-kalman", e)
-    }
-}
+trajpred_core::crate_error!(KalmanError, "trajpred-kalman");

@@ -1,5 +1,4 @@
 use thiserror::Error;
-use trajpred_core::CrateError;
 
 /// What can be wrong with the input of a metric.
 ///
@@ -51,19 +50,40 @@ pub enum MetricsError {
     },
 }
 
-impl CrateError for MetricsError {
-    fn split_core(self) -> std::result::Result<trajpred_core::Error, Self> {
-        match self {
-            MetricsError::Core(e) => Ok(e),
-            own => Err(own),
+trajpred_core::crate_error!(MetricsError, "trajpred-metrics");
+
+/// The start of every metric over a pair of sequences: `others` as long as `items`
+/// (`LengthMismatch` naming the pair `what`) and at least one item (`Empty` naming `empty`);
+/// returns the first item.
+pub(crate) fn first_of_pair<'a, A, B>(
+    items: &'a [A],
+    others: &[B],
+    what: &'static str,
+    empty: &'static str,
+) -> Result<&'a A, MetricsError> {
+    if items.len() != others.len() {
+        return Err(trajpred_core::Error::LengthMismatch {
+            what,
+            expected: items.len(),
+            got: others.len(),
         }
+        .into());
     }
+    items
+        .first()
+        .ok_or(trajpred_core::Error::Empty { what: empty }.into())
 }
 
-/// A shared variant comes back as the core error itself, the metrics' own variants as
-/// [`trajpred_core::Error::Method`] naming `trajpred-metrics`.
-impl From<MetricsError> for trajpred_core::Error {
-    fn from(e: MetricsError) -> Self {
-        trajpred_core::Error::from_crate("trajpred-metrics", e)
+/// `NonFinite { what, index }` unless every value is finite (`index` is the item's, not the
+/// value's).
+pub(crate) fn check_finite<'a>(
+    values: impl IntoIterator<Item = &'a f64>,
+    what: &'static str,
+    index: usize,
+) -> Result<(), MetricsError> {
+    if values.into_iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(trajpred_core::Error::NonFinite { what, index }.into())
     }
 }

@@ -1,7 +1,6 @@
 //! The error type of `trajpred-neural`.
 
 use thiserror::Error;
-use trajpred_core::CrateError;
 pub(crate) use trajpred_core::Error as CoreError;
 
 /// Everything that can go wrong while building, training, running, saving or loading a
@@ -71,14 +70,7 @@ impl NeuralError {
     }
 }
 
-impl CrateError for NeuralError {
-    fn split_core(self) -> std::result::Result<trajpred_core::Error, Self> {
-        match self {
-            NeuralError::Core(e) => Ok(e),
-            own => Err(own),
-        }
-    }
-}
-
 /// `Result` with [`NeuralError`].
 pub type Result<T, E = NeuralError> = std::result::Result<T, E>;
+
+trajpred_core::crate_error!(NeuralError, "trajpred-neural");

@@ -1,7 +1,6 @@
 //! The error type of `trajpred-sparse`.
 
 use thiserror::Error;
-use trajpred_core::CrateError;
 
 /// Everything that can go wrong when fitting or using a LARS path or a group sparse coder.
 ///
@@ -54,19 +53,4 @@ pub enum Error {
 /// `Result` with [`enum@Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
-impl CrateError for Error {
-    fn split_core(self) -> std::result::Result<trajpred_core::Error, Self> {
-        match self {
-            Error::Core(e) => Ok(e),
-            own => Err(own),
-        }
-    }
-}
-
-/// A shared variant comes back as the core error itself, the sparse coders' own variants as
-/// [`trajpred_core::Error::Method`] naming `trajpred-sparse`.
-impl From<Error> for trajpred_core::Error {
-    fn from(e: Error) -> Self {
-        trajpred_core::Error::from_crate("trajpred-sparse", e)
-    }
-}
+trajpred_core::crate_error!(Error, "trajpred-sparse");
