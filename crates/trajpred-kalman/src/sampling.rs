@@ -61,30 +61,9 @@ where
         return Ok(chol.unpack());
     }
     let tol = T::default_epsilon() * nalgebra::convert::<f64, T>(64.0 * n as f64) * scale;
-    let mut l = c.clone_owned();
-    l.fill(T::zero());
-    for j in 0..n {
-        let mut d = c[(j, j)];
-        for k in 0..j {
-            d -= l[(j, k)] * l[(j, k)];
-        }
-        if d < -tol {
-            return Err(CoreError::NotPositiveDefinite { what }.into());
-        }
-        if d <= tol {
-            continue; // a zero column
-        }
-        let ljj = d.sqrt();
-        l[(j, j)] = ljj;
-        for i in (j + 1)..n {
-            let mut s = c[(i, j)];
-            for k in 0..j {
-                s -= l[(i, k)] * l[(j, k)];
-            }
-            l[(i, j)] = s / ljj;
-        }
-    }
-    Ok(l)
+    Chol::semidefinite(c.clone_owned(), tol)
+        .map(Chol::unpack)
+        .ok_or(CoreError::NotPositiveDefinite { what }.into())
 }
 
 /// Appends `count` standard normal variates, drawn in `f64` and converted to `T` (a seeded

@@ -39,49 +39,45 @@ fn a_small_variance_is_not_taken_for_a_zero_one() {
     assert!((l[(1, 1)] - 1e-3).abs() < 1e-9, "{l}");
 }
 
+/// The shared error a sampler function returned, which must be one (a `KalmanError::Core`).
+fn core_error<T: std::fmt::Debug>(r: Result<T, KalmanError>) -> CoreError {
+    match r {
+        Err(KalmanError::Core(e)) => e,
+        other => panic!("expected a shared error, got {other:?}"),
+    }
+}
+
 #[test]
 fn bad_covariances_are_typed_errors() {
-    let r = covariance_sqrt(&Matrix2::new(1.0, 0.0, 0.0, -1.0), "Q");
+    for (bad, what) in [
+        (Matrix2::new(1.0, 0.0, 0.0, -1.0), "a negative variance"),
+        (Matrix2::new(1.0, 0.5, 0.0, 1.0), "asymmetric"),
+    ] {
+        let e = core_error(covariance_sqrt(&bad, "Q"));
+        assert!(
+            matches!(e, CoreError::NotPositiveDefinite { what: "Q" }),
+            "{what}: {e:?}"
+        );
+    }
+    let e = core_error(covariance_sqrt(&Matrix2::new(1.0, 0.0, 0.0, f64::NAN), "Q"));
     assert!(
         matches!(
-            r,
-            Err(KalmanError::Core(CoreError::NotPositiveDefinite {
-                what: "Q"
-            }))
-        ),
-        "{r:?}"
-    );
-    let r = covariance_sqrt(&Matrix2::new(1.0, 0.5, 0.0, 1.0), "Q");
-    assert!(
-        matches!(
-            r,
-            Err(KalmanError::Core(CoreError::NotPositiveDefinite {
-                what: "Q"
-            }))
-        ),
-        "{r:?}"
-    );
-    let r = covariance_sqrt(&Matrix2::new(1.0, 0.0, 0.0, f64::NAN), "Q");
-    assert!(
-        matches!(
-            r,
-            Err(KalmanError::Core(CoreError::NonFinite {
+            e,
+            CoreError::NonFinite {
                 what: "Q",
                 index: 3
-            }))
+            }
         ),
-        "{r:?}"
+        "{e:?}"
     );
     // a density needs a definite S
-    let r = ZeroMeanGaussian::new(&Matrix2::new(1.0, 1.0, 1.0, 1.0), "S");
+    let e = core_error(ZeroMeanGaussian::new(
+        &Matrix2::new(1.0, 1.0, 1.0, 1.0),
+        "S",
+    ));
     assert!(
-        matches!(
-            r,
-            Err(KalmanError::Core(CoreError::NotPositiveDefinite {
-                what: "S"
-            }))
-        ),
-        "{r:?}"
+        matches!(e, CoreError::NotPositiveDefinite { what: "S" }),
+        "{e:?}"
     );
 }
 
