@@ -1,5 +1,6 @@
 //! Filter consistency: NEES, NIS and their chi-square bounds.
 
+use crate::error::{check_finite, first_of_pair};
 use crate::{MetricsError, Result};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -8,18 +9,13 @@ use trajpred_core::Error as CoreError;
 
 /// Normalised squared errors `e_i^T P_i^-1 e_i`, solved through Cholesky (no inverse).
 fn normalised_squares(errors: &[DVector<f64>], covariances: &[DMatrix<f64>]) -> Result<Vec<f64>> {
-    if errors.len() != covariances.len() {
-        return Err(CoreError::LengthMismatch {
-            what: "covariances vs error vectors",
-            expected: errors.len(),
-            got: covariances.len(),
-        }
-        .into());
-    }
-    let dim = errors
-        .first()
-        .ok_or(CoreError::Empty { what: "errors" })?
-        .len();
+    let dim = first_of_pair(
+        errors,
+        covariances,
+        "covariances vs error vectors",
+        "errors",
+    )?
+    .len();
     errors
         .iter()
         .zip(covariances)
@@ -45,20 +41,8 @@ fn normalised_squares(errors: &[DVector<f64>], covariances: &[DMatrix<f64>]) -> 
                     },
                 });
             }
-            if e.iter().any(|v| !v.is_finite()) {
-                return Err(CoreError::NonFinite {
-                    what: "error vector",
-                    index,
-                }
-                .into());
-            }
-            if p.iter().any(|v| !v.is_finite()) {
-                return Err(CoreError::NonFinite {
-                    what: "covariance",
-                    index,
-                }
-                .into());
-            }
+            check_finite(e, "error vector", index)?;
+            check_finite(p, "covariance", index)?;
             let chol = p
                 .clone()
                 .cholesky()

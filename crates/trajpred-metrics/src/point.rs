@@ -1,22 +1,18 @@
 //! Point-wise error measures.
 
+use crate::error::{check_finite, first_of_pair};
 use crate::{MetricsError, Result};
 use serde::{Deserialize, Serialize};
 use trajpred_core::Error as CoreError;
 
 /// Checks a (predicted, actual) pair of point lists and returns the common number of axes.
 fn check<P: AsRef<[f64]>, Q: AsRef<[f64]>>(predicted: &[P], actual: &[Q]) -> Result<usize> {
-    if predicted.len() != actual.len() {
-        return Err(CoreError::LengthMismatch {
-            what: "actual points vs predicted points",
-            expected: predicted.len(),
-            got: actual.len(),
-        }
-        .into());
-    }
-    let first = predicted
-        .first()
-        .ok_or(CoreError::Empty { what: "points" })?;
+    let first = first_of_pair(
+        predicted,
+        actual,
+        "actual points vs predicted points",
+        "points",
+    )?;
     let dim = first.as_ref().len();
     if dim == 0 {
         return Err(CoreError::Empty { what: "point 0" }.into());
@@ -33,20 +29,8 @@ fn check<P: AsRef<[f64]>, Q: AsRef<[f64]>>(predicted: &[P], actual: &[Q]) -> Res
                 .into());
             }
         }
-        if p.iter().any(|v| !v.is_finite()) {
-            return Err(CoreError::NonFinite {
-                what: "predicted",
-                index,
-            }
-            .into());
-        }
-        if a.iter().any(|v| !v.is_finite()) {
-            return Err(CoreError::NonFinite {
-                what: "actual",
-                index,
-            }
-            .into());
-        }
+        check_finite(p, "predicted", index)?;
+        check_finite(a, "actual", index)?;
     }
     Ok(dim)
 }
@@ -243,17 +227,7 @@ where
     P: AsRef<[f64]>,
     Q: AsRef<[f64]>,
 {
-    if forecasts.len() != actual.len() {
-        return Err(CoreError::LengthMismatch {
-            what: "actual tracks vs forecasts",
-            expected: forecasts.len(),
-            got: actual.len(),
-        }
-        .into());
-    }
-    let first = forecasts
-        .first()
-        .ok_or(CoreError::Empty { what: "forecasts" })?;
+    let first = first_of_pair(forecasts, actual, "actual tracks vs forecasts", "forecasts")?;
     let horizon = first.as_ref().len();
     if horizon == 0 {
         return Err(CoreError::Empty { what: "forecast 0" }.into());

@@ -5,6 +5,14 @@ use nalgebra::{DMatrix, DVector, dmatrix, dvector};
 use trajpred_core::Error as CoreError;
 use trajpred_metrics::*;
 
+/// The shared error a metric returned, which must be one (a `MetricsError::Core`).
+fn core_error<T: std::fmt::Debug>(r: Result<T>) -> CoreError {
+    match r {
+        Err(MetricsError::Core(e)) => e,
+        other => panic!("expected a shared error, got {other:?}"),
+    }
+}
+
 // Three 3-D points; errors (pred - truth): (1,2,2) |3|, (0,0,0) |0|, (2,3,6) |7|.
 const TRUTH: [[f64; 3]; 3] = [[1.0, 1.0, 1.0], [2.0, -1.0, 4.0], [-1.0, 2.0, 0.5]];
 const PRED: [[f64; 3]; 3] = [[2.0, 3.0, 3.0], [2.0, -1.0, 4.0], [1.0, 5.0, 6.5]];
@@ -45,15 +53,15 @@ fn rmse_3d_is_eq_21() {
 
 #[test]
 fn rmse_3d_wants_three_axes() {
-    let e = rmse_3d(&[[1.0, 2.0]], &[[0.0, 0.0]]).unwrap_err();
+    let e = core_error(rmse_3d(&[[1.0, 2.0]], &[[0.0, 0.0]]));
     assert!(
         matches!(
             e,
-            MetricsError::Core(CoreError::DimensionMismatch {
+            CoreError::DimensionMismatch {
                 expected: 3,
                 got: 2,
                 ..
-            })
+            }
         ),
         "{e:?}"
     );
@@ -82,11 +90,11 @@ fn hit_rate_counts_strictly_below() {
     assert_abs_diff_eq!(hit_rate(&PRED, &TRUTH, 25.0).unwrap(), 1.0);
     for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         assert!(matches!(
-            hit_rate(&PRED, &TRUTH, bad),
-            Err(MetricsError::Core(CoreError::InvalidParameter {
+            core_error(hit_rate(&PRED, &TRUTH, bad)),
+            CoreError::InvalidParameter {
                 name: "threshold",
                 ..
-            }))
+            }
         ));
     }
 }
@@ -142,28 +150,31 @@ fn per_horizon_rejects_ragged_forecasts() {
     let f = vec![vec![[0.0], [f64::NAN]]];
     let a = vec![vec![[0.0], [0.0]]];
     assert!(matches!(
-        per_horizon(&f, &a),
-        Err(MetricsError::Core(CoreError::NonFinite {
+        core_error(per_horizon(&f, &a)),
+        CoreError::NonFinite {
             what: "predicted",
             index: 0
-        }))
+        }
     ));
     let empty: Vec<Vec<[f64; 1]>> = vec![];
     assert!(matches!(
-        per_horizon(&empty, &empty),
-        Err(MetricsError::Core(CoreError::Empty { what: "forecasts" }))
+        core_error(per_horizon(&empty, &empty)),
+        CoreError::Empty { what: "forecasts" }
     ));
     assert!(matches!(
-        per_horizon(&[Vec::<[f64; 1]>::new()], &[Vec::<[f64; 1]>::new()]),
-        Err(MetricsError::Core(CoreError::Empty { what: "forecast 0" }))
+        core_error(per_horizon(
+            &[Vec::<[f64; 1]>::new()],
+            &[Vec::<[f64; 1]>::new()]
+        )),
+        CoreError::Empty { what: "forecast 0" }
     ));
     assert!(matches!(
-        per_horizon(&f, &[a[0].clone(), a[0].clone()]),
-        Err(MetricsError::Core(CoreError::LengthMismatch {
+        core_error(per_horizon(&f, &[a[0].clone(), a[0].clone()])),
+        CoreError::LengthMismatch {
             expected: 1,
             got: 2,
             ..
-        }))
+        }
     ));
 }
 
@@ -196,23 +207,23 @@ fn nees_errors() {
         })
     ));
     assert!(matches!(
-        nees(&[dvector![f64::NAN, 0.0]], &[DMatrix::identity(2, 2)]),
-        Err(MetricsError::Core(CoreError::NonFinite {
+        core_error(nees(&[dvector![f64::NAN, 0.0]], &[DMatrix::identity(2, 2)])),
+        CoreError::NonFinite {
             what: "error vector",
             index: 0
-        }))
+        }
     ));
     assert!(matches!(
-        nees(&[], &[]),
-        Err(MetricsError::Core(CoreError::Empty { what: "errors" }))
+        core_error(nees(&[], &[])),
+        CoreError::Empty { what: "errors" }
     ));
     assert!(matches!(
-        nees(&[DVector::zeros(2)], &[]),
-        Err(MetricsError::Core(CoreError::LengthMismatch {
+        core_error(nees(&[DVector::zeros(2)], &[])),
+        CoreError::LengthMismatch {
             expected: 1,
             got: 0,
             ..
-        }))
+        }
     ));
 }
 
@@ -241,26 +252,26 @@ fn consistency_test() {
     let c = consistency(&[50.0, 60.0], 2, 0.95).unwrap();
     assert!(!c.consistent);
     assert!(matches!(
-        consistency(&[1.0], 2, 1.5),
-        Err(MetricsError::Core(CoreError::InvalidParameter {
+        core_error(consistency(&[1.0], 2, 1.5)),
+        CoreError::InvalidParameter {
             name: "confidence",
             ..
-        }))
+        }
     ));
     assert!(matches!(
-        consistency(&[1.0], 0, 0.9),
-        Err(MetricsError::Core(CoreError::InvalidParameter {
+        core_error(consistency(&[1.0], 0, 0.9)),
+        CoreError::InvalidParameter {
             name: "degrees of freedom",
             ..
-        }))
+        }
     ));
     assert!(matches!(
-        consistency(&[], 2, 0.9),
-        Err(MetricsError::Core(CoreError::Empty { what: "samples" }))
+        core_error(consistency(&[], 2, 0.9)),
+        CoreError::Empty { what: "samples" }
     ));
     assert!(matches!(
-        consistency(&[-1.0], 2, 0.9),
-        Err(MetricsError::Core(CoreError::NonFinite { index: 0, .. }))
+        core_error(consistency(&[-1.0], 2, 0.9)),
+        CoreError::NonFinite { index: 0, .. }
     ));
 }
 
@@ -284,60 +295,60 @@ fn every_point_metric_rejects_bad_input() {
     let one = vec![vec![1.0, 1.0]];
     let two = vec![vec![1.0, 1.0], vec![2.0, 2.0]];
     for (name, m) in metrics {
-        let e = m(&[], &[]).unwrap_err();
+        let e = core_error(m(&[], &[]));
         assert!(
-            matches!(e, MetricsError::Core(CoreError::Empty { what: "points" })),
+            matches!(e, CoreError::Empty { what: "points" }),
             "{name}: {e:?}"
         );
-        let e = m(&one, &two).unwrap_err();
+        let e = core_error(m(&one, &two));
         assert!(
             matches!(
                 e,
-                MetricsError::Core(CoreError::LengthMismatch {
+                CoreError::LengthMismatch {
                     expected: 1,
                     got: 2,
                     ..
-                })
+                }
             ),
             "{name}: {e:?}"
         );
-        let e = m(&two, &[vec![1.0, 1.0], vec![2.0]]).unwrap_err();
+        let e = core_error(m(&two, &[vec![1.0, 1.0], vec![2.0]]));
         assert!(
             matches!(
                 e,
-                MetricsError::Core(CoreError::PointDimension {
+                CoreError::PointDimension {
                     index: 1,
                     expected: 2,
                     got: 1
-                })
+                }
             ),
             "{name}: {e:?}"
         );
-        let e = m(&[vec![1.0, f64::NAN]], &one).unwrap_err();
+        let e = core_error(m(&[vec![1.0, f64::NAN]], &one));
         assert!(
             matches!(
                 e,
-                MetricsError::Core(CoreError::NonFinite {
+                CoreError::NonFinite {
                     what: "predicted",
                     index: 0
-                })
+                }
             ),
             "{name}: {e:?}"
         );
-        let e = m(&two, &[vec![1.0, 1.0], vec![f64::INFINITY, 1.0]]).unwrap_err();
+        let e = core_error(m(&two, &[vec![1.0, 1.0], vec![f64::INFINITY, 1.0]]));
         assert!(
             matches!(
                 e,
-                MetricsError::Core(CoreError::NonFinite {
+                CoreError::NonFinite {
                     what: "actual",
                     index: 1
-                })
+                }
             ),
             "{name}: {e:?}"
         );
-        let e = m(&[vec![]], &[vec![]]).unwrap_err();
+        let e = core_error(m(&[vec![]], &[vec![]]));
         assert!(
-            matches!(e, MetricsError::Core(CoreError::Empty { what: "point 0" })),
+            matches!(e, CoreError::Empty { what: "point 0" }),
             "{name}: {e:?}"
         );
     }
