@@ -246,10 +246,7 @@ macro_rules! crate_error {
             }
         }
 
-        #[doc = concat!(
-                    "A shared variant comes back as the core error itself, the others as ",
-                    "`trajpred_core::Error::Method` naming `", $name, "`."
-                )]
+        #[doc = concat!("A shared variant as the core error itself, the others naming `", $name, "`.")]
         impl From<$error> for $crate::Error {
             fn from(e: $error) -> Self {
                 $crate::Error::from_crate($name, e)
