@@ -217,7 +217,7 @@ pub trait CrateError: std::error::Error + Send + Sync + Sized + 'static {
 }
 
 /// The convention's conversions for a crate's error enum `$error` whose shared variant is
-/// `Core(trajpred_core::Error)`: [`CrateError`], and `From<$error>` for [`Error`] (a shared
+/// `Core(trajpred_core::Error)`: [`CrateError`], and `From<$error>` for [`enum@Error`] (a shared
 /// variant as itself, the crate's own variants wrapped in [`Error::Method`] naming `$name`).
 ///
 /// ```

@@ -164,7 +164,7 @@ where
 /// observation, the batch over a sequence and the k-step forecast.
 ///
 /// Inputs are validated (shapes, finite values, `P` symmetric positive semi-definite);
-/// failures are typed [`KalmanError`]s.
+/// failures are typed [`KalmanError`](crate::KalmanError)s.
 pub trait Filter<T: RealField + Copy, D: Dim, M: Dim>
 where
     DefaultAllocator: FilterAllocator<D, M>,
