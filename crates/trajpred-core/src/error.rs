@@ -1,9 +1,17 @@
-//! The error type shared by the core types and the [`Predictor`](crate::Predictor) trait.
+//! The error type shared by the core types, the [`Predictor`](crate::Predictor) trait and,
+//! through their `Core` variants, every other crate of the workspace ([`CrateError`]).
 
 use thiserror::Error;
 
 /// Everything that can go wrong in `trajpred-core`, and what a [`Predictor`](crate::Predictor)
-/// reports. Every variant names what was wrong and, where there is one, the first bad index.
+/// reports. Every variant names what was wrong and, where there is one, the first bad index
+/// or the offending value.
+///
+/// The input errors every crate shares (`Empty`, `LengthMismatch`, `DimensionMismatch`,
+/// `PointDimension`, `NonFinite`, `TooShort`, `InvalidParameter`, `NotPositiveDefinite`, ...)
+/// are declared here only: the error enums of the other crates hold them in a variant
+/// `Core(trajpred_core::Error)` and declare only their own variants besides (see
+/// [`CrateError`]).
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum Error {
@@ -95,7 +103,7 @@ pub enum Error {
     InvalidParameter {
         /// The parameter's name.
         name: &'static str,
-        /// Why it is invalid.
+        /// Why it is invalid, quoting the offending value (`"must be positive, got -1"`).
         reason: String,
     },
     /// A matrix that must be symmetric positive definite is not.
@@ -153,6 +161,98 @@ impl Error {
             source: Box::new(source),
         }
     }
+
+    /// An error of another crate as this one: the shared variant it holds in its `Core`
+    /// variant is returned as it is (so `Error::InvalidParameter` is matched the same way
+    /// whichever crate raised it), any variant of the crate's own is wrapped in
+    /// [`Error::Method`] naming `method`.
+    ///
+    /// ```
+    /// use trajpred_core::{CrateError, Error};
+    /// #[derive(Debug, thiserror::Error)]
+    /// enum MyError {
+    ///     #[error(transparent)]
+    ///     Core(#[from] Error),
+    ///     #[error("diverged")]
+    ///     Diverged,
+    /// }
+    /// impl CrateError for MyError {
+    ///     fn split_core(self) -> Result<Error, Self> {
+    ///         match self {
+    ///             MyError::Core(e) => Ok(e),
+    ///             other => Err(other),
+    ///         }
+    ///     }
+    /// }
+    /// let shared = MyError::Core(Error::Empty { what: "history" });
+    /// assert!(matches!(Error::from_crate("mine", shared), Error::Empty { what: "history" }));
+    /// let own = Error::from_crate("mine", MyError::Diverged);
+    /// assert_eq!(own.to_string(), "mine: diverged");
+    /// ```
+    pub fn from_crate<E: CrateError>(method: impl Into<String>, error: E) -> Self {
+        error
+            .split_core()
+            .unwrap_or_else(|own| Error::method(method, own))
+    }
+
+    /// [`Error::InvalidParameter`] naming the parameter; `reason` should quote the offending
+    /// value (`format!("must be positive, got {v}")`).
+    pub fn invalid_parameter(name: &'static str, reason: impl Into<String>) -> Self {
+        Error::InvalidParameter {
+            name,
+            reason: reason.into(),
+        }
+    }
+}
+
+/// The error convention of the workspace (`docs/architecture.md`, "Errors"): a crate's error
+/// enum is `#[non_exhaustive]`, holds the variants every crate shares in one variant
+/// `Core(#[from] trajpred_core::Error)` (so `?` converts a core error) and declares only the
+/// variants specific to that crate besides. This trait splits such an error into the two
+/// kinds; [`Error::from_crate`] uses it to convert into this crate's error.
+pub trait CrateError: std::error::Error + Send + Sync + Sized + 'static {
+    /// The core error held by the `Core` variant, or `Err(self)` for a variant of the crate's
+    /// own.
+    fn split_core(self) -> std::result::Result<Error, Self>;
+}
+
+/// The convention's conversions for a crate's error enum `$error` whose shared variant is
+/// `Core(trajpred_core::Error)`: [`CrateError`], and `From<$error>` for [`enum@Error`] (a shared
+/// variant as itself, the crate's own variants wrapped in [`Error::Method`] naming `$name`).
+///
+/// ```
+/// use trajpred_core::Error;
+/// #[derive(Debug, thiserror::Error)]
+/// enum MyError {
+///     #[error(transparent)]
+///     Core(#[from] Error),
+///     #[error("diverged")]
+///     Diverged,
+/// }
+/// trajpred_core::crate_error!(MyError, "my-crate");
+/// let e: Error = MyError::Core(Error::Empty { what: "history" }).into();
+/// assert!(matches!(e, Error::Empty { what: "history" }));
+/// assert_eq!(Error::from(MyError::Diverged).to_string(), "my-crate: diverged");
+/// ```
+#[macro_export]
+macro_rules! crate_error {
+    ($error:ident, $name:literal) => {
+        impl $crate::CrateError for $error {
+            fn split_core(self) -> ::std::result::Result<$crate::Error, Self> {
+                match self {
+                    $error::Core(e) => Ok(e),
+                    own => Err(own),
+                }
+            }
+        }
+
+        #[doc = concat!("A shared variant as the core error itself, the others naming `", $name, "`.")]
+        impl From<$error> for $crate::Error {
+            fn from(e: $error) -> Self {
+                $crate::Error::from_crate($name, e)
+            }
+        }
+    };
 }
 
 /// `Result` with [`enum@Error`].

@@ -9,7 +9,7 @@ pub mod predictor;
 pub mod trajectory;
 pub mod window;
 
-pub use error::{Error, Result};
+pub use error::{CrateError, Error, Result};
 pub use gaussian::Gaussian;
 pub use predictor::{
     Forecast, MAX_HORIZON, Predictor, check_forecast_args, check_forecast_args_with_max,

@@ -324,7 +324,7 @@ pub fn check_forecast_args_with_max(
     if horizon == 0 {
         return Err(Error::InvalidParameter {
             name: "horizon",
-            reason: "must be at least 1".into(),
+            reason: format!("must be at least 1, got {horizon}"),
         });
     }
     if horizon > max_horizon {

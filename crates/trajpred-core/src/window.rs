@@ -66,7 +66,7 @@ pub fn windows(series: &[f64], m: usize) -> Result<std::slice::Windows<'_, f64>>
     if m == 0 {
         return Err(Error::InvalidParameter {
             name: "m",
-            reason: "window length must be at least 1".into(),
+            reason: format!("window length must be at least 1, got {m}"),
         });
     }
     if series.len() < m {
@@ -89,13 +89,13 @@ fn check_window(m: usize, t: usize) -> Result<()> {
     if m == 0 {
         return Err(Error::InvalidParameter {
             name: "m",
-            reason: "window length must be at least 1".into(),
+            reason: format!("window length must be at least 1, got {m}"),
         });
     }
     if t == 0 {
         return Err(Error::InvalidParameter {
             name: "t",
-            reason: "horizon must be at least 1".into(),
+            reason: format!("horizon must be at least 1, got {t}"),
         });
     }
     Ok(())

@@ -452,10 +452,12 @@ fn label(e: &Error) -> String {
     match e {
         Error::Io { .. } => "Io".into(),
         Error::Parse { .. } => "Parse".into(),
-        Error::InvalidParameter { name, .. } => format!("InvalidParameter({name})"),
+        Error::Core(trajpred_core::Error::InvalidParameter { name, .. }) => {
+            format!("InvalidParameter({name})")
+        }
         Error::Layout { .. } => "Layout".into(),
         Error::LimitExceeded { option, .. } => format!("LimitExceeded({option})"),
-        Error::Trajectory(_) => "Trajectory".into(),
+        Error::Core(_) => "Core".into(),
         _ => "other".into(),
     }
 }

@@ -4,6 +4,11 @@
 use thiserror::Error;
 
 /// Everything that can go wrong while loading, converting or generating trajectories.
+///
+/// The errors every crate shares are [`trajpred_core::Error`]'s variants, wrapped in
+/// [`Error::Core`]: match them as
+/// `Error::Core(trajpred_core::Error::InvalidParameter { name: "dt", .. })`. The variants
+/// declared here are the loaders' own.
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum Error {
@@ -26,15 +31,6 @@ pub enum Error {
         /// 1-based record index where noted in `reason`).
         line: usize,
         /// What was wrong.
-        reason: String,
-    },
-    /// A parameter outside its valid domain (a bounding box with min > max, a negative gap,
-    /// a latitude beyond ±90°, a non-finite SNR, ...).
-    #[error("invalid parameter `{name}`: {reason}")]
-    InvalidParameter {
-        /// The parameter's name.
-        name: &'static str,
-        /// Why it is invalid.
         reason: String,
     },
     /// A path that should be a directory of the expected layout is not.
@@ -63,9 +59,12 @@ pub enum Error {
         /// What crossed it, in words ("line length in bytes", ...).
         what: &'static str,
     },
-    /// A trajectory could not be built (see [`trajpred_core::Error`]).
+    /// An error shared with the other crates (see [`trajpred_core::Error`]): a trajectory that
+    /// could not be built, or `InvalidParameter` (a bounding box with min > max, a negative
+    /// gap, a latitude beyond ±90°, a non-finite SNR, ..., with the offending value). Its
+    /// message is the core error's.
     #[error(transparent)]
-    Trajectory(#[from] trajpred_core::Error),
+    Core(#[from] trajpred_core::Error),
 }
 
 /// `Result` with [`enum@Error`].
@@ -92,11 +91,9 @@ impl Error {
         }
     }
 
+    /// [`trajpred_core::Error::InvalidParameter`]; `reason` quotes the offending value.
     pub(crate) fn param(name: &'static str, reason: impl Into<String>) -> Self {
-        Error::InvalidParameter {
-            name,
-            reason: reason.into(),
-        }
+        Error::Core(trajpred_core::Error::invalid_parameter(name, reason))
     }
 }
 
@@ -136,3 +133,5 @@ impl std::fmt::Display for LimitHit {
 }
 
 impl std::error::Error for LimitHit {}
+
+trajpred_core::crate_error!(Error, "trajpred-data");

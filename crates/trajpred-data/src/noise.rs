@@ -35,7 +35,7 @@ pub fn noise_sigma(signal: &[f64], snr_db: f64) -> Result<f64> {
     if let Some(i) = signal.iter().position(|v| !v.is_finite()) {
         return Err(Error::param(
             "signal",
-            format!("non-finite value at index {i}"),
+            format!("non-finite value {} at index {i}", signal[i]),
         ));
     }
     let power = signal.iter().map(|v| v * v).sum::<f64>() / signal.len() as f64;

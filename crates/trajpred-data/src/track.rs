@@ -193,19 +193,25 @@ impl LoadOptions {
             ));
         }
         if self.min_points == 0 {
-            return Err(Error::param("min_points", "must be at least 1"));
+            return Err(Error::param("min_points", "must be at least 1, got 0"));
         }
         if let Projection::Enu(o) = self.projection {
             LocalFrame::new(o)?;
         }
         if self.max_line_bytes == 0 {
-            return Err(Error::param("max_line_bytes", "must be at least 1"));
+            return Err(Error::param("max_line_bytes", "must be at least 1, got 0"));
         }
         if self.max_track_points == 0 {
-            return Err(Error::param("max_track_points", "must be at least 1"));
+            return Err(Error::param(
+                "max_track_points",
+                "must be at least 1, got 0",
+            ));
         }
         if self.max_total_points == 0 {
-            return Err(Error::param("max_total_points", "must be at least 1"));
+            return Err(Error::param(
+                "max_total_points",
+                "must be at least 1, got 0",
+            ));
         }
         Ok(())
     }

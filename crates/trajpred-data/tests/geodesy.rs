@@ -137,7 +137,9 @@ fn invalid_positions_are_typed_errors() {
     ] {
         assert!(matches!(
             Geodetic::new(lat, lon, alt),
-            Err(trajpred_data::Error::InvalidParameter { .. })
+            Err(trajpred_data::Error::Core(
+                trajpred_core::Error::InvalidParameter { .. }
+            ))
         ));
     }
     let bad = Geodetic {
@@ -147,10 +149,12 @@ fn invalid_positions_are_typed_errors() {
     };
     assert!(matches!(
         LocalFrame::new(bad),
-        Err(trajpred_data::Error::InvalidParameter {
-            name: "lat_deg",
-            ..
-        })
+        Err(trajpred_data::Error::Core(
+            trajpred_core::Error::InvalidParameter {
+                name: "lat_deg",
+                ..
+            }
+        ))
     ));
 }
 

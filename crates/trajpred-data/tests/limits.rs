@@ -7,6 +7,7 @@ use flate2::Compression;
 use flate2::write::GzEncoder;
 use std::io::Write;
 use std::path::PathBuf;
+use trajpred_core::Error as CoreError;
 use trajpred_data::{
     Error, LoadOptions, LoadReport, MAX_JSON_BYTES, MAX_LINE_BYTES, SkipReason, adsb, csvfile,
     geolife, tdrive,
@@ -439,7 +440,7 @@ fn limits_of_zero_are_invalid_parameters() {
     ] {
         let mut r = LoadReport::new();
         match tdrive::parse(tdrive_lines(1).as_bytes(), "x.txt", &opts, &mut r) {
-            Err(Error::InvalidParameter { name: n, .. }) => assert_eq!(n, name),
+            Err(Error::Core(CoreError::InvalidParameter { name: n, .. })) => assert_eq!(n, name),
             other => panic!("{name}: {other:?}"),
         }
     }

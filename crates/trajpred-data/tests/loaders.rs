@@ -2,6 +2,7 @@
 //! `make_fixtures.py`; the expected counts and lines are annotated there, line by line).
 
 use std::path::PathBuf;
+use trajpred_core::Error as CoreError;
 use trajpred_data::geodesy::{FOOT, Geodetic, LocalFrame};
 use trajpred_data::{
     Error, Frame, LoadOptions, LoadReport, Projection, SkipReason, adsb, csvfile, geolife, tdrive,
@@ -366,10 +367,10 @@ fn invalid_options_are_rejected() {
     };
     assert!(matches!(
         tdrive::load_file(&fixture("tdrive/7.txt"), &bad),
-        Err(Error::InvalidParameter {
+        Err(Error::Core(CoreError::InvalidParameter {
             name: "max_gap",
             ..
-        })
+        }))
     ));
     let bad = LoadOptions {
         min_points: 0,
@@ -377,14 +378,17 @@ fn invalid_options_are_rejected() {
     };
     assert!(matches!(
         csvfile::load_file(&fixture("csv/xy.csv"), &bad),
-        Err(Error::InvalidParameter {
+        Err(Error::Core(CoreError::InvalidParameter {
             name: "min_points",
             ..
-        })
+        }))
     ));
     assert!(matches!(
         trajpred_data::BoundingBox::new(40.0, 39.0, 116.0, 117.0),
-        Err(Error::InvalidParameter { name: "bbox", .. })
+        Err(Error::Core(CoreError::InvalidParameter {
+            name: "bbox",
+            ..
+        }))
     ));
 }
 

@@ -1,6 +1,7 @@
 //! Segmentation and resampling: hand-worked cases and properties.
 
 use proptest::prelude::*;
+use trajpred_core::Error as CoreError;
 use trajpred_core::Trajectory;
 use trajpred_data::Error;
 use trajpred_data::segment::{keep_min_points, resample, split_on_gaps};
@@ -29,11 +30,11 @@ fn resample_interpolates_linearly_between_neighbours() {
     assert_eq!(resample(&one, 1.0).unwrap(), one);
     assert!(matches!(
         resample(&tr, 0.0),
-        Err(Error::InvalidParameter { name: "dt", .. })
+        Err(Error::Core(CoreError::InvalidParameter { name: "dt", .. }))
     ));
     assert!(matches!(
         resample(&tr, 1e-300),
-        Err(Error::InvalidParameter { name: "dt", .. })
+        Err(Error::Core(CoreError::InvalidParameter { name: "dt", .. }))
     ));
 }
 
@@ -46,10 +47,10 @@ fn split_and_filter() {
     assert_eq!(keep_min_points(parts, 2).len(), 1);
     assert!(matches!(
         split_on_gaps(&tr, -1.0),
-        Err(Error::InvalidParameter {
+        Err(Error::Core(CoreError::InvalidParameter {
             name: "max_gap",
             ..
-        })
+        }))
     ));
 }
 

@@ -63,7 +63,9 @@ fn patent_curves_follow_their_equations() {
     }
     assert!(matches!(
         PatentCurve::Helix.generate(10, 0.0),
-        Err(trajpred_data::Error::InvalidParameter { name: "dt", .. })
+        Err(trajpred_data::Error::Core(
+            trajpred_core::Error::InvalidParameter { name: "dt", .. }
+        ))
     ));
     assert!(PatentCurve::Helix.generate(0, 0.1).is_err());
 }
@@ -76,11 +78,15 @@ fn noise_sigma_is_signal_power_over_snr() {
     assert_eq!(noise_sigma(&[0.0; 5], 10.0).unwrap(), 0.0);
     assert!(matches!(
         noise_sigma(&[1.0], f64::NAN),
-        Err(trajpred_data::Error::InvalidParameter { name: "snr_db", .. })
+        Err(trajpred_data::Error::Core(
+            trajpred_core::Error::InvalidParameter { name: "snr_db", .. }
+        ))
     ));
     assert!(matches!(
         noise_sigma(&[1.0, f64::INFINITY], 3.0),
-        Err(trajpred_data::Error::InvalidParameter { name: "signal", .. })
+        Err(trajpred_data::Error::Core(
+            trajpred_core::Error::InvalidParameter { name: "signal", .. }
+        ))
     ));
 }
 

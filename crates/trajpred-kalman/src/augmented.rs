@@ -8,9 +8,9 @@ use crate::driver::scan;
 use crate::error::Result;
 use crate::filter::{InputChecks, Step, Update, validate_state};
 use crate::linalg::{check_dim, check_finite, ldl, symmetrise};
-use crate::model::{LinearObservation, LinearTransition, Observation, Transition, validate_models};
+use crate::model::{LinearObservation, LinearTransition, Observation, Transition};
 use crate::motion::{CoordinatedTurn, RangeBearing};
-use crate::ukf::{MerweSigmaPoints, SigmaWeights};
+use crate::ukf::{AugmentedNoise, SigmaPointFilter};
 use nalgebra::allocator::Allocator;
 use nalgebra::{Const, DMatrix, DefaultAllocator, Dim, OMatrix, OVector, RealField, U2, U5};
 use trajpred_core::Gaussian;
@@ -79,13 +79,7 @@ impl<T: RealField + Copy, D: Dim> NoisyObservation<T, D, U2> for RangeBearing<T>
 /// update uses `Z_i = h(Y_i, v_i)` (no redraw): `z_hat`, `S`, `Pxz` from the same points,
 /// `K = Pxz S^-1`, `x = y_bar + K (z - z_hat)`, `P = P_bar - K S K^T`. No `Q` or `R` is added:
 /// the noise is inside the points. Works on heap storage for the augmented matrices.
-#[derive(Debug, Clone)]
-pub struct AugmentedUkf<T, Tr, Ob> {
-    transition: Tr,
-    observation: Ob,
-    points: MerweSigmaPoints<T>,
-    weights: SigmaWeights<T>,
-}
+pub type AugmentedUkf<T, Tr, Ob> = SigmaPointFilter<T, Tr, Ob, AugmentedNoise>;
 
 /// Moments of the propagated augmented sigma points.
 struct AugmentedMoments<T: RealField, D: Dim, M: Dim>
@@ -100,33 +94,6 @@ where
 }
 
 impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
-    /// An augmented UKF; the sigma-point weights are for the augmented dimension `2n + m`.
-    pub fn new<D: Dim, M: Dim>(
-        transition: Tr,
-        observation: Ob,
-        points: MerweSigmaPoints<T>,
-    ) -> Result<Self>
-    where
-        Tr: NoisyTransition<T, D>,
-        Ob: NoisyObservation<T, D, M>,
-        DefaultAllocator: FilterAllocator<D, M>,
-    {
-        validate_models(&transition, &observation)?;
-        let l = 2 * transition.state_dim() + observation.observation_dim();
-        let weights = points.weights(l)?;
-        Ok(AugmentedUkf {
-            transition,
-            observation,
-            points,
-            weights,
-        })
-    }
-
-    /// The sigma-point parameters.
-    pub fn points(&self) -> &MerweSigmaPoints<T> {
-        &self.points
-    }
-
     fn moments<D: Dim, M: Dim>(&self, state: &Gaussian<T, D>) -> Result<AugmentedMoments<T, D, M>>
     where
         Tr: NoisyTransition<T, D>,
@@ -153,7 +120,7 @@ impl<T: RealField + Copy, Tr, Ob> AugmentedUkf<T, Tr, Ob> {
             }
         }
         let c = self.weights.lambda + nalgebra::convert::<f64, T>(l as f64);
-        // the augmented covariance: Q may be singular, so factor with the PSD jitter
+        // the augmented covariance: Q may be singular, so a semi-definite square root
         let la = crate::sampling::covariance_sqrt(&(pa * c), "augmented covariance")?;
         let d = state.mean.shape_generic().0;
         let md = M::from_usize(m);

@@ -44,6 +44,7 @@ use crate::error::{KalmanError, Result};
 use crate::filter::Filter;
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OVector, RealField};
+use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 
 /// A filter that the driver can run: it holds its estimate, advances it over a time step
@@ -72,10 +73,11 @@ pub fn check_dt<T: RealField + Copy>(dt: T, what: &'static str) -> Result<()> {
     if dt.is_finite() && dt > T::zero() {
         Ok(())
     } else {
-        Err(KalmanError::InvalidParameter {
+        Err(CoreError::InvalidParameter {
             name: what,
             reason: format!("time step must be finite and positive, got {dt}"),
-        })
+        }
+        .into())
     }
 }
 
@@ -125,11 +127,11 @@ where
     DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M>,
 {
     if times.len() != observations.len() {
-        return Err(KalmanError::DimensionMismatch {
+        return Err(KalmanError::Core(CoreError::DimensionMismatch {
             what: "times vs observations",
             expected: times.len(),
             got: observations.len(),
-        }
+        })
         .into());
     }
     scan(1..times.len(), |_, k| {

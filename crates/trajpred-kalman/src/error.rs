@@ -4,43 +4,23 @@ use thiserror::Error;
 
 /// Everything that can go wrong in `trajpred-kalman`. Numerical failure is reported here,
 /// never through a panic or a NaN in the output.
-#[derive(Debug, Clone, PartialEq, Error)]
+///
+/// The input errors every crate shares are [`trajpred_core::Error`]'s variants, wrapped in
+/// [`KalmanError::Core`]: match them as
+/// `KalmanError::Core(trajpred_core::Error::NotPositiveDefinite { what: "S" })`. The variants
+/// declared here are the filters' own.
+#[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum KalmanError {
-    /// A vector or matrix has the wrong number of rows or columns.
-    #[error("dimension mismatch in {what}: expected {expected}, got {got}")]
-    DimensionMismatch {
-        /// Which input or model output disagrees.
-        what: &'static str,
-        /// The dimension that was required.
-        expected: usize,
-        /// The dimension that was given.
-        got: usize,
-    },
-    /// A value was NaN or infinite (an input, or a result that overflowed).
-    #[error("non-finite value in {what} at index {index}")]
-    NonFinite {
-        /// Which vector or matrix held the value.
-        what: &'static str,
-        /// Column-major index of the first non-finite value.
-        index: usize,
-    },
-    /// A matrix that must be symmetric positive (semi-)definite is not: the state covariance
-    /// `P`, the noise covariances `Q` and `R`, the innovation covariance `S`, or a predicted
-    /// covariance inverted by the smoother.
-    #[error("{what} is not symmetric positive definite")]
-    NotPositiveDefinite {
-        /// Which matrix (`"P"`, `"Q"`, `"R"`, `"S"`, ...).
-        what: &'static str,
-    },
-    /// A parameter outside its valid domain (a non-positive time step, a negative variance, ...).
-    #[error("invalid parameter `{name}`: {reason}")]
-    InvalidParameter {
-        /// The parameter's name.
-        name: &'static str,
-        /// Why it is invalid.
-        reason: String,
-    },
+    /// An input error shared with the other crates (see [`trajpred_core::Error`]):
+    /// `DimensionMismatch` (a vector or matrix with the wrong number of rows or columns),
+    /// `NonFinite` (an input, or a result that overflowed; the index is column-major for a
+    /// matrix), `NotPositiveDefinite` (the state covariance `"P"`, the noise covariances
+    /// `"Q"` and `"R"`, the innovation covariance `"S"`, or a predicted covariance inverted by
+    /// the smoother), `InvalidParameter` (a non-positive time step, a negative variance, ...)
+    /// and `Empty`. Its message is the core error's.
+    #[error(transparent)]
+    Core(#[from] trajpred_core::Error),
     /// Sigma-point parameters whose weights are degenerate: `n + lambda <= 0` (the weights
     /// `1 / (2 (n + lambda))` are infinite or negative) or not finite.
     #[error(
@@ -63,19 +43,9 @@ pub enum KalmanError {
         /// What could not be evaluated.
         what: &'static str,
     },
-    /// A sequence that must hold at least one element was empty.
-    #[error("{what} is empty")]
-    Empty {
-        /// What was empty.
-        what: &'static str,
-    },
 }
 
 /// `Result` with [`KalmanError`].
 pub type Result<T, E = KalmanError> = std::result::Result<T, E>;
 
-impl From<KalmanError> for trajpred_core::Error {
-    fn from(e: KalmanError) -> Self {
-        trajpred_core::Error::method("trajpred-kalman", e)
-    }
-}
+trajpred_core::crate_error!(KalmanError, "trajpred-kalman");

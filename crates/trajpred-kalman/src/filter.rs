@@ -4,7 +4,7 @@
 
 use crate::alloc::FilterAllocator;
 use crate::driver::scan;
-use crate::error::{KalmanError, Result};
+use crate::error::Result;
 use crate::linalg::{
     Ldl, all_finite, check_dim, check_finite, check_square, check_state, congruence_ldl, is_static,
     joseph, ldl, mean_finite_and_symmetric, mul, mul_tr_sym_plus, mul_vec,
@@ -13,6 +13,7 @@ use crate::linalg::{
 use crate::model::{LinearTransitionModel, Observation};
 use nalgebra::allocator::Allocator;
 use nalgebra::{Const, DefaultAllocator, Dim, OMatrix, OVector, RealField};
+use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 
 /// How much of the input state `predict` and `update` verify.
@@ -163,7 +164,7 @@ where
 /// observation, the batch over a sequence and the k-step forecast.
 ///
 /// Inputs are validated (shapes, finite values, `P` symmetric positive semi-definite);
-/// failures are typed [`KalmanError`]s.
+/// failures are typed [`KalmanError`](crate::KalmanError)s.
 pub trait Filter<T: RealField + Copy, D: Dim, M: Dim>
 where
     DefaultAllocator: FilterAllocator<D, M>,
@@ -378,7 +379,7 @@ where
     ) -> Result<PredictionWithCross<T, D>>;
 
     /// Smooths filtered estimates (e.g. the posteriors of [`Filter::filter`]'s steps, in
-    /// time order). Errors with [`KalmanError::Empty`] for no states.
+    /// time order). Errors with [`trajpred_core::Error::Empty`] for no states.
     fn smooth(&self, filtered: &[Gaussian<T, D>]) -> Result<Vec<Gaussian<T, D>>> {
         self.smooth_with_gains(filtered).map(|s| s.states)
     }
@@ -386,12 +387,13 @@ where
     /// [`Smoother::smooth`], also returning the smoother gains `G(k) = C(k) P(k+1|k)^-1`
     /// (`k = 0 .. N-2`), as filterpy's `rts_smoother` returns `K` (filterpy returns `N`
     /// gains, the last one zero; here there are `N - 1`, none for the last state, which
-    /// the smoother leaves as filtered). Errors with [`KalmanError::Empty`] for no states.
+    /// the smoother leaves as filtered). Errors with [`trajpred_core::Error::Empty`] for no states.
     fn smooth_with_gains(&self, filtered: &[Gaussian<T, D>]) -> Result<RtsSmoothed<T, D>> {
         if filtered.is_empty() {
-            return Err(KalmanError::Empty {
+            return Err(CoreError::Empty {
                 what: "filtered states",
-            });
+            }
+            .into());
         }
         let mut out: Vec<Gaussian<T, D>> = filtered.to_vec();
         let mut gains = Vec::with_capacity(filtered.len() - 1);
@@ -458,7 +460,7 @@ where
     })
 }
 
-/// A prediction's mean and covariance are finite, or [`KalmanError::NonFinite`] naming the
+/// A prediction's mean and covariance are finite, or [`trajpred_core::Error::NonFinite`] naming the
 /// first that is not (one branch; the element is located only on failure).
 #[inline(always)]
 pub(crate) fn check_prediction<T, D>(prior: &Gaussian<T, D>) -> Result<()>
@@ -652,23 +654,13 @@ where
     if !(all_finite(&post.mean) & all_finite(&post.covariance) & update.nis.is_finite()) {
         check_finite(&post.mean, "posterior mean")?;
         check_finite(&post.covariance, "posterior covariance")?;
-        return Err(KalmanError::NonFinite {
+        return Err(CoreError::NonFinite {
             what: "normalised innovation squared",
             index: 0,
-        });
+        }
+        .into());
     }
     Ok(update)
-}
-
-/// `ln N(y; 0, S)` from the `L D L^T` factorisation of `S`.
-#[inline(always)]
-pub(crate) fn gaussian_log_likelihood<T, M>(s: &Ldl<T, M>, y: &OVector<T, M>) -> T
-where
-    T: RealField + Copy,
-    M: Dim,
-    DefaultAllocator: Allocator<M> + Allocator<M, M>,
-{
-    log_likelihood_from(y.nrows(), s.log_det(), s.quadratic_form(y))
 }
 
 /// Validates a state against the transition's dimension (shared by every filter's steps).

@@ -19,50 +19,19 @@ use crate::alloc::FilterAllocator;
 use crate::driver::scan;
 use crate::error::Result;
 use crate::filter::{CovarianceUpdate, InputChecks, validate_state};
-use crate::linalg::{check_dim, check_finite, check_pd, ldl, symmetrise};
+use crate::linalg::{check_dim, check_finite, ldl, symmetrise};
 use crate::model::{LinearObservationModel, LinearTransitionModel, validate_models};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
 use trajpred_core::Gaussian;
 
 /// A residual `V = Z - H X(k|k-1)` and its covariance `S = H P(k|k-1) H^T + R`: what the IKF
-/// carries from one step to the next.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Innovation<T: RealField, M: Dim>
-where
-    DefaultAllocator: Allocator<M> + Allocator<M, M>,
-{
-    /// The residual `V`.
-    pub residual: OVector<T, M>,
-    /// Its covariance `S`.
-    pub covariance: OMatrix<T, M, M>,
-}
-
-impl<T: RealField + Copy, M: Dim> Innovation<T, M>
-where
-    DefaultAllocator: Allocator<M> + Allocator<M, M>,
-{
-    /// An innovation assembled by the caller (the GSKF builds its residuals per horizon).
-    /// Checks sizes, finiteness and that `S` is symmetric positive definite.
-    pub fn new(residual: OVector<T, M>, covariance: OMatrix<T, M, M>) -> Result<Self> {
-        check_dim(
-            "innovation covariance",
-            residual.nrows(),
-            covariance.nrows(),
-        )?;
-        check_dim(
-            "innovation covariance",
-            residual.nrows(),
-            covariance.ncols(),
-        )?;
-        check_finite(&residual, "residual")?;
-        check_pd(&covariance, "S")?;
-        Ok(Innovation {
-            residual,
-            covariance,
-        })
-    }
-}
+/// carries from one step to the next, as the core [`Gaussian`] `N(V, S)` (the residual in
+/// `mean`). It is the IKF's model of the innovation it cannot see yet: eq. 12-13 correct the
+/// prediction of step `k` with `V(k-1)` in place of `V(k)`, and `S(k-1)` in place of `S(k)`.
+/// [`Gaussian::new`] checks the shapes, finiteness and symmetry; [`Ikf::correct`] checks that
+/// `S` is positive definite where it solves with it.
+pub type Innovation<T, M> = Gaussian<T, M>;
 
 /// One IKF step: the plain prediction, the corrected one-step-ahead prediction, and the
 /// innovation of this step's observation (when there was one).
@@ -190,7 +159,7 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
         let mut covariance =
             h * &prior.covariance * h.transpose() + self.observation.observation_noise();
         symmetrise(&mut covariance);
-        Innovation::new(residual, covariance)
+        Ok(Innovation::new(residual, covariance)?)
     }
 
     /// Eq. 12-13: the corrected one-step-ahead prediction
@@ -208,9 +177,9 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
         let n = self.transition.state_dim();
         validate_state(prior, n, InputChecks::Full)?;
         let m = self.observation.observation_dim();
-        check_dim("previous residual", m, previous.residual.nrows())?;
+        check_dim("previous residual", m, previous.mean.nrows())?;
         check_dim("previous S", m, previous.covariance.nrows())?;
-        check_finite(&previous.residual, "previous residual")?;
+        check_finite(&previous.mean, "previous residual")?;
         let h = self.observation.observation_matrix();
         let p = &prior.covariance;
         let hp = h * p;
@@ -218,7 +187,7 @@ impl<Tr, Ob> Ikf<Tr, Ob> {
         let mut kt = hp.clone();
         factors.solve_mut(&mut kt);
         let gain = kt.transpose();
-        let mean = &prior.mean + &gain * &previous.residual;
+        let mean = &prior.mean + &gain * &previous.mean;
         let mut cov = match self.covariance_update {
             CovarianceUpdate::Joseph => {
                 let mut ikh = -(&gain * h);

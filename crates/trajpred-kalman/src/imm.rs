@@ -28,7 +28,7 @@
 //! posterior mode probabilities and a finite `ln L`. (filterpy floors each likelihood at
 //! `2.2e-308` and so returns `cbar` in that case.) A mode whose `ln L_j` is `-inf` or NaN, or
 //! whose `cbar_j` is 0, gets probability 0; when no mode is left the step fails with
-//! [`KalmanError::NonFinite`] (`"IMM mode log-likelihoods"`).
+//! [`trajpred_core::Error::NonFinite`] (`"IMM mode log-likelihoods"`).
 //!
 //! **Unreachable modes.** When `cbar_j = 0` (no mode switches into `j`: a zero column of
 //! `M`, or only modes of probability 0 do), `w_ij` is undefined; mode `j` then starts from
@@ -93,6 +93,7 @@ use nalgebra::{
     DMatrix, DefaultAllocator, Dim, Matrix2, Matrix2x5, Matrix5, OMatrix, OVector, RealField, U2,
     U4, U5,
 };
+use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 
 /// How far a row of the transition matrix (or the initial mode probabilities) may sum from 1;
@@ -118,7 +119,7 @@ where
     /// the mode filters at the first step.
     pub fn new(modes: Vec<Gaussian<T, D>>, probabilities: Vec<T>) -> Result<Self> {
         if modes.is_empty() {
-            return Err(KalmanError::Empty { what: "IMM modes" });
+            return Err(CoreError::Empty { what: "IMM modes" }.into());
         }
         check_dim("mode probabilities", modes.len(), probabilities.len())?;
         let n = modes[0].mean.nrows();
@@ -149,7 +150,7 @@ where
     }
 
     /// The combined estimate: the mean and covariance of the mixture
-    /// `sum_j mu_j N(x_j, P_j)`. Errors with [`KalmanError::NonFinite`] when they overflow
+    /// `sum_j mu_j N(x_j, P_j)`. Errors with [`trajpred_core::Error::NonFinite`] when they overflow
     /// (modes of finite but huge means far apart).
     pub fn combined(&self) -> Result<Gaussian<T, D>> {
         let g = moments(&self.probabilities, &self.modes);
@@ -193,20 +194,22 @@ where
 /// [`ROW_SUM_TOLERANCE`]) and divides it by its sum.
 fn normalised_row<T: RealField + Copy>(row: &[T], what: &'static str) -> Result<Vec<T>> {
     if let Some(i) = row.iter().position(|p| !p.is_finite()) {
-        return Err(KalmanError::NonFinite { what, index: i });
+        return Err(CoreError::NonFinite { what, index: i }.into());
     }
     if let Some(p) = row.iter().find(|&&p| p < T::zero()) {
-        return Err(KalmanError::InvalidParameter {
+        return Err(CoreError::InvalidParameter {
             name: what,
             reason: format!("probabilities must be >= 0, got {p}"),
-        });
+        }
+        .into());
     }
     let sum = row.iter().fold(T::zero(), |a, &p| a + p);
     if (sum - T::one()).abs() > nalgebra::convert(ROW_SUM_TOLERANCE) {
-        return Err(KalmanError::InvalidParameter {
+        return Err(CoreError::InvalidParameter {
             name: what,
             reason: format!("must sum to 1 (within {ROW_SUM_TOLERANCE:e}), got {sum}"),
-        });
+        }
+        .into());
     }
     Ok(row.iter().map(|&p| p / sum).collect())
 }
@@ -245,7 +248,7 @@ impl<T: RealField + Copy, F> Imm<T, F> {
     pub fn new(modes: Vec<F>, transition: DMatrix<T>) -> Result<Self> {
         let r = modes.len();
         if r == 0 {
-            return Err(KalmanError::Empty { what: "IMM modes" });
+            return Err(CoreError::Empty { what: "IMM modes" }.into());
         }
         check_dim("transition matrix rows", r, transition.nrows())?;
         check_dim("transition matrix columns", r, transition.ncols())?;
@@ -394,10 +397,11 @@ impl<T: RealField + Copy, F> Imm<T, F> {
             .flatten()
             .fold(None, |m: Option<T>, &v| Some(m.map_or(v, |m| m.max(v))));
         let Some(top) = top else {
-            return Err(KalmanError::NonFinite {
+            return Err(CoreError::NonFinite {
                 what: "IMM mode log-likelihoods",
                 index: lls.iter().position(|l| !l.is_finite()).unwrap_or(0),
-            });
+            }
+            .into());
         };
         let e: Vec<T> = a
             .iter()
@@ -470,14 +474,15 @@ pub fn uniform_switching<T: RealField + Copy>(
     mean_sojourn: f64,
 ) -> Result<DMatrix<T>> {
     if modes == 0 {
-        return Err(KalmanError::Empty { what: "IMM modes" });
+        return Err(CoreError::Empty { what: "IMM modes" }.into());
     }
     check_dt(dt, "dt")?;
     if !(mean_sojourn.is_finite() && mean_sojourn > 0.0) {
-        return Err(KalmanError::InvalidParameter {
+        return Err(CoreError::InvalidParameter {
             name: "mean_sojourn",
             reason: format!("must be finite and positive, got {mean_sojourn}"),
-        });
+        }
+        .into());
     }
     if modes == 1 {
         return Ok(DMatrix::from_element(1, 1, T::one()));
@@ -520,10 +525,11 @@ pub fn coordinated_turn_continuous<T: RealField + Copy>(
 ) -> Result<CoordinatedTurn<T>> {
     let mut q = *constant_velocity_in_turn_state::<T>(dt, accel_density)?.q();
     if !(turn_rate_density.is_finite() && turn_rate_density >= 0.0) {
-        return Err(KalmanError::InvalidParameter {
+        return Err(CoreError::InvalidParameter {
             name: "turn_rate_density",
             reason: format!("must be finite and >= 0, got {turn_rate_density}"),
-        });
+        }
+        .into());
     }
     q[(4, 4)] = nalgebra::convert(turn_rate_density * dt);
     CoordinatedTurn::with_process_noise(dt, q)
@@ -538,10 +544,11 @@ pub fn turn_state_position_observation<T: RealField + Copy>(
     h[(0, 0)] = T::one();
     h[(1, 2)] = T::one();
     if !(var.is_finite() && var > 0.0) {
-        return Err(KalmanError::InvalidParameter {
+        return Err(CoreError::InvalidParameter {
             name: "var",
             reason: format!("observation variance must be finite and positive, got {var}"),
-        });
+        }
+        .into());
     }
     LinearObservation::new(h, Matrix2::identity() * nalgebra::convert::<f64, T>(var))
 }

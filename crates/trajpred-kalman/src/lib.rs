@@ -28,7 +28,10 @@ pub use model::{
     Observation, ObservationJacobian, SigmaImages, Transition, TransitionJacobian,
 };
 pub mod ukf;
-pub use ukf::{MerweSigmaPoints, SigmaWeights, Ukf};
+pub use ukf::{
+    AdditiveNoise, AugmentedNoise, MerweSigmaPoints, SigmaPointFilter, SigmaSpace, SigmaWeights,
+    Ukf,
+};
 pub mod motion;
 pub use motion::{CoordinatedTurn, RangeBearing, StateOrder};
 pub mod ikf;

@@ -1,15 +1,16 @@
 //! Small numerical helpers shared by every filter: checks of finiteness, shape and
 //! definiteness, Cholesky factorisation with typed errors, symmetrisation.
 
-use crate::error::{KalmanError, Result};
+use crate::error::Result;
 use nalgebra::allocator::Allocator;
 use nalgebra::{Const, DefaultAllocator, Dim, Matrix, OMatrix, OVector, RealField, Storage};
+use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 
 mod factor;
 pub(crate) use factor::{Chol, Ldl, cholesky, ldl};
 
-/// Errors with [`KalmanError::NonFinite`] if any element of `m` is NaN or infinite.
+/// Errors with [`trajpred_core::Error::NonFinite`] if any element of `m` is NaN or infinite.
 #[inline(always)]
 pub(crate) fn check_finite<T, R, C, S>(m: &Matrix<T, R, C, S>, what: &'static str) -> Result<()>
 where
@@ -22,9 +23,15 @@ where
         return Ok(());
     }
     match m.iter().position(|v| !v.is_finite()) {
-        Some(index) => Err(KalmanError::NonFinite { what, index }),
+        Some(index) => Err(CoreError::NonFinite { what, index }.into()),
         None => Ok(()),
     }
+}
+
+/// `v` as `f64` (NaN if it cannot be represented, which the callers reject as non-finite).
+#[inline(always)]
+pub(crate) fn to_f64<T: RealField + Copy>(v: T) -> f64 {
+    nalgebra::try_convert::<T, f64>(v).unwrap_or(f64::NAN)
 }
 
 /// `true` when no element of `m` is NaN or infinite: one pass without early exit, so the
@@ -261,17 +268,18 @@ where
     Some(mul_tr_sym_plus(&md, &m, q))
 }
 
-/// Errors with [`KalmanError::DimensionMismatch`] unless `got == expected`.
+/// Errors with [`trajpred_core::Error::DimensionMismatch`] unless `got == expected`.
 #[inline(always)]
 pub(crate) fn check_dim(what: &'static str, expected: usize, got: usize) -> Result<()> {
     if expected == got {
         Ok(())
     } else {
-        Err(KalmanError::DimensionMismatch {
+        Err(CoreError::DimensionMismatch {
             what,
             expected,
             got,
-        })
+        }
+        .into())
     }
 }
 
@@ -455,11 +463,11 @@ where
     let tol = symmetry_tolerance(scale);
     for j in 0..n {
         if m[(j, j)] < T::zero() {
-            return Err(KalmanError::NotPositiveDefinite { what });
+            return Err(CoreError::NotPositiveDefinite { what }.into());
         }
         for i in 0..j {
             if (m[(i, j)] - m[(j, i)]).abs() > tol {
-                return Err(KalmanError::NotPositiveDefinite { what });
+                return Err(CoreError::NotPositiveDefinite { what }.into());
             }
         }
     }
@@ -470,7 +478,7 @@ where
     if positive_definite_shifted(m.clone(), jitter) {
         Ok(())
     } else {
-        Err(KalmanError::NotPositiveDefinite { what })
+        Err(CoreError::NotPositiveDefinite { what }.into())
     }
 }
 
@@ -538,7 +546,7 @@ where
     for j in 0..n {
         for i in 0..j {
             if (m[(i, j)] - m[(j, i)]).abs() > tol {
-                return Err(KalmanError::NotPositiveDefinite { what });
+                return Err(CoreError::NotPositiveDefinite { what }.into());
             }
         }
     }
@@ -590,11 +598,11 @@ where
     let tol = symmetry_tolerance(p.amax());
     for j in 0..n {
         if p[(j, j)] < T::zero() {
-            return Err(KalmanError::NotPositiveDefinite { what: "P" });
+            return Err(CoreError::NotPositiveDefinite { what: "P" }.into());
         }
         for i in 0..j {
             if (p[(i, j)] - p[(j, i)]).abs() > tol {
-                return Err(KalmanError::NotPositiveDefinite { what: "P" });
+                return Err(CoreError::NotPositiveDefinite { what: "P" }.into());
             }
         }
     }

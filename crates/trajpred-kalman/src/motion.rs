@@ -4,7 +4,7 @@
 //!
 //! The kinematic models are generic over the state dimension type `D`: ask for a static
 //! size (`nalgebra::U4` for 2-D constant velocity) or `nalgebra::Dyn`; a static size that does
-//! not fit the number of axes is a [`KalmanError::DimensionMismatch`].
+//! not fit the number of axes is a [`trajpred_core::Error::DimensionMismatch`].
 
 use crate::error::{KalmanError, Result};
 use crate::linalg::{check_dim, check_pd, check_psd};
@@ -16,6 +16,7 @@ use nalgebra::allocator::Allocator;
 use nalgebra::{
     DefaultAllocator, Dim, Matrix2, Matrix5, OMatrix, OVector, RealField, U2, U5, Vector2, Vector5,
 };
+use trajpred_core::Error as CoreError;
 
 /// How the kinematic state of several axes is laid out.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -41,20 +42,22 @@ pub struct KinematicLayout {
 }
 
 impl KinematicLayout {
-    /// A layout; errors with [`KalmanError::InvalidParameter`] unless `axes` is 1..=3 and
+    /// A layout; errors with [`trajpred_core::Error::InvalidParameter`] unless `axes` is 1..=3 and
     /// `derivatives` 2 or 3.
     pub fn new(axes: usize, derivatives: usize, order: StateOrder) -> Result<Self> {
         if !(1..=3).contains(&axes) {
-            return Err(KalmanError::InvalidParameter {
+            return Err(CoreError::InvalidParameter {
                 name: "axes",
                 reason: format!("must be 1, 2 or 3, got {axes}"),
-            });
+            }
+            .into());
         }
         if !(2..=3).contains(&derivatives) {
-            return Err(KalmanError::InvalidParameter {
+            return Err(CoreError::InvalidParameter {
                 name: "derivatives",
                 reason: format!("must be 2 (CV) or 3 (CA), got {derivatives}"),
-            });
+            }
+            .into());
         }
         Ok(KinematicLayout {
             axes,
@@ -102,13 +105,14 @@ fn check_positive(name: &'static str, v: f64, allow_zero: bool) -> Result<()> {
     if ok {
         Ok(())
     } else {
-        Err(KalmanError::InvalidParameter {
+        Err(CoreError::InvalidParameter {
             name,
             reason: format!(
                 "must be finite and {}, got {v}",
                 if allow_zero { ">= 0" } else { "> 0" }
             ),
-        })
+        }
+        .into())
     }
 }
 
@@ -255,13 +259,14 @@ where
     check_positive("spectral_density", spectral_density, true)?;
     check_positive("time_constant", time_constant, false)?;
     if layout.derivatives != 2 {
-        return Err(KalmanError::InvalidParameter {
+        return Err(CoreError::InvalidParameter {
             name: "layout",
             reason: format!(
                 "damped velocity has 2 derivatives per axis, got {}",
                 layout.derivatives
             ),
-        });
+        }
+        .into());
     }
     let (q, beta) = (spectral_density, 1.0 / time_constant);
     let bdt = beta * dt;
@@ -640,10 +645,11 @@ impl<T: RealField + Copy> RangeBearing<T> {
         );
         check_pd(&r, "R")?;
         if sensor.iter().any(|v| !v.is_finite()) {
-            return Err(KalmanError::NonFinite {
+            return Err(CoreError::NonFinite {
                 what: "sensor position",
                 index: sensor.iter().position(|v| !v.is_finite()).unwrap_or(0),
-            });
+            }
+            .into());
         }
         Ok(RangeBearing {
             sensor,
@@ -659,11 +665,12 @@ impl<T: RealField + Copy> RangeBearing<T> {
     {
         let need = self.x_index.max(self.y_index) + 1;
         if x.nrows() < need {
-            return Err(KalmanError::DimensionMismatch {
+            return Err(CoreError::DimensionMismatch {
                 what: "state too short for the position indices",
                 expected: need,
                 got: x.nrows(),
-            });
+            }
+            .into());
         }
         Ok((
             x[self.x_index] - self.sensor.x,

@@ -5,11 +5,13 @@ use crate::alloc::FilterAllocator;
 use crate::error::{KalmanError, Result};
 use crate::filter::{Filter, InputChecks, PredictionWithCross, Smoother, Update, validate_state};
 use crate::linalg::{
-    check_dim, check_finite, cholesky, ldl, mul, mul_tr_sym_plus, mul_vec, symmetrise,
+    check_dim, check_finite, cholesky, ldl, mul, mul_tr_sym_plus, mul_vec, symmetrise, to_f64,
 };
 use crate::model::{Observation, SigmaImages, Transition, validate_models};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
+use std::marker::PhantomData;
+use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 
 /// Merwe's scaled sigma points (`docs/papers.md` C.1 eq. 10-11): for a state of dimension `n`,
@@ -36,13 +38,14 @@ impl<T: RealField + Copy> MerweSigmaPoints<T> {
     /// The weights for a state of dimension `n`. Errors with
     /// [`KalmanError::DegenerateSigmaPoints`] when a parameter is not finite, `alpha <= 0`
     /// or `n + lambda = alpha^2 (n + kappa) <= 0` (the weights `1 / (2 (n + lambda))` would
-    /// be infinite or negative), and [`KalmanError::InvalidParameter`] for `n = 0`.
+    /// be infinite or negative), and [`trajpred_core::Error::InvalidParameter`] for `n = 0`.
     pub fn weights(&self, n: usize) -> Result<SigmaWeights<T>> {
         if n == 0 {
-            return Err(KalmanError::InvalidParameter {
+            return Err(CoreError::InvalidParameter {
                 name: "n",
-                reason: "the state dimension must be at least 1".into(),
-            });
+                reason: format!("the state dimension must be at least 1, got {n}"),
+            }
+            .into());
         }
         let nt = nalgebra::convert::<f64, T>(n as f64);
         let lambda = self.alpha * self.alpha * (nt + self.kappa) - nt;
@@ -106,10 +109,6 @@ impl<T: RealField + Copy> Default for MerweSigmaPoints<T> {
             kappa: T::zero(),
         }
     }
-}
-
-fn to_f64<T: RealField + Copy>(v: T) -> f64 {
-    nalgebra::try_convert::<T, f64>(v).unwrap_or(f64::NAN)
 }
 
 /// The weights of Merwe's sigma points for one state dimension.
@@ -300,18 +299,62 @@ const UKF_CHECKS: InputChecks = InputChecks::Cheap;
 ///
 /// The weights are computed once, at construction, for the transition's state size; a
 /// parameter set with degenerate weights is rejected there.
+pub type Ukf<T, Tr, Ob> = SigmaPointFilter<T, Tr, Ob, AdditiveNoise>;
+
+/// An unscented filter: the models, Merwe's sigma-point parameters and their weights for the
+/// space `S` the sigma points are drawn in. [`Ukf`] draws them in the state space
+/// ([`AdditiveNoise`]), [`AugmentedUkf`](crate::AugmentedUkf) in the space of the state and
+/// both noises ([`AugmentedNoise`]); the two differ only in their steps.
 #[derive(Debug, Clone)]
-pub struct Ukf<T, Tr, Ob> {
-    transition: Tr,
-    observation: Ob,
-    points: MerweSigmaPoints<T>,
-    weights: SigmaWeights<T>,
+pub struct SigmaPointFilter<T, Tr, Ob, S> {
+    pub(crate) transition: Tr,
+    pub(crate) observation: Ob,
+    pub(crate) points: MerweSigmaPoints<T>,
+    pub(crate) weights: SigmaWeights<T>,
+    space: PhantomData<fn() -> S>,
 }
 
-impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
-    /// A UKF from a transition (`f`, `Q`), an observation (`h`, `R`) and sigma-point
-    /// parameters. Errors: [`KalmanError::DegenerateSigmaPoints`], and the model checks of
-    /// `Q` and `R`.
+/// The space an unscented filter draws its sigma points in: its dimension for a state of
+/// size `n` and an observation of size `m`. Implemented by [`AdditiveNoise`] and
+/// [`AugmentedNoise`] only.
+pub trait SigmaSpace: sealed::Sealed {
+    /// The number of dimensions the sigma points have (the weights are for it).
+    fn dim(n: usize, m: usize) -> usize;
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for super::AdditiveNoise {}
+    impl Sealed for super::AugmentedNoise {}
+}
+
+/// The state space, `n` dimensions: the noise covariances are added to the moments
+/// ([`Ukf`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AdditiveNoise;
+
+/// The state and both noises, `2n + m` dimensions: the noise is inside the points
+/// ([`AugmentedUkf`](crate::AugmentedUkf)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AugmentedNoise;
+
+impl SigmaSpace for AdditiveNoise {
+    fn dim(n: usize, _m: usize) -> usize {
+        n
+    }
+}
+
+impl SigmaSpace for AugmentedNoise {
+    fn dim(n: usize, m: usize) -> usize {
+        2 * n + m
+    }
+}
+
+impl<T: RealField + Copy, Tr, Ob, S: SigmaSpace> SigmaPointFilter<T, Tr, Ob, S> {
+    /// A filter from a transition (`f`, `Q`), an observation (`h`, `R`) and sigma-point
+    /// parameters, the weights computed once for the dimension of `S` (`n` for [`Ukf`],
+    /// `2n + m` for [`AugmentedUkf`](crate::AugmentedUkf)). Errors:
+    /// [`KalmanError::DegenerateSigmaPoints`], and the model checks of `Q` and `R`.
     pub fn new<D: Dim, M: Dim>(
         transition: Tr,
         observation: Ob,
@@ -323,12 +366,14 @@ impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
         DefaultAllocator: FilterAllocator<D, M>,
     {
         validate_models(&transition, &observation)?;
-        let weights = points.weights(transition.state_dim())?;
-        Ok(Ukf {
+        let dim = S::dim(transition.state_dim(), observation.observation_dim());
+        let weights = points.weights(dim)?;
+        Ok(SigmaPointFilter {
             transition,
             observation,
             points,
             weights,
+            space: PhantomData,
         })
     }
 
@@ -337,7 +382,7 @@ impl<T: RealField + Copy, Tr, Ob> Ukf<T, Tr, Ob> {
         &self.points
     }
 
-    /// The sigma-point weights for this filter's state size.
+    /// The sigma-point weights, for the dimension of `S`.
     pub fn weights(&self) -> &SigmaWeights<T> {
         &self.weights
     }

@@ -8,6 +8,7 @@
 
 use nalgebra::{DVector, Matrix2, Matrix2x4, Matrix4, U4, Vector2, Vector4};
 use serde_json::Value;
+use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 use trajpred_kalman::driver::{TimeStepFilter, Timed, drive};
 use trajpred_kalman::motion::{KinematicLayout, StateOrder, kinematic, kinematic_continuous};
@@ -192,24 +193,27 @@ fn bad_time_steps_are_typed_errors() {
     let z = vec![None, Some(Vector2::new(1.0, 0.0)), None];
     for times in [[0.0, 1.0, 1.0], [0.0, 1.0, 0.5], [0.0, f64::NAN, 2.0]] {
         match drive(&mut f, &times, &z, |_, _| Ok(())) {
-            Err(KalmanError::InvalidParameter { name: "times", .. }) => {}
+            Err(KalmanError::Core(CoreError::InvalidParameter { name: "times", .. })) => {}
             other => panic!("{times:?}: expected a bad time step, got {other:?}"),
         }
     }
     assert!(matches!(
         drive(&mut f, &[0.0, 1.0], &z, |_, _| Ok(())),
-        Err(KalmanError::DimensionMismatch { .. })
+        Err(KalmanError::Core(CoreError::DimensionMismatch { .. }))
     ));
     assert!(matches!(
         f.forecast_at(&[0.0]),
-        Err(KalmanError::InvalidParameter {
+        Err(KalmanError::Core(CoreError::InvalidParameter {
             name: "forecast offset",
             ..
-        })
+        }))
     ));
     assert!(matches!(
         f.advance(-1.0, None),
-        Err(KalmanError::InvalidParameter { name: "dt", .. })
+        Err(KalmanError::Core(CoreError::InvalidParameter {
+            name: "dt",
+            ..
+        }))
     ));
 }
 

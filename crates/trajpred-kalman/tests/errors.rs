@@ -4,6 +4,7 @@ use nalgebra::{
     DMatrix, DVector, Matrix1, Matrix1x2, Matrix2, Matrix4, U2, U4, U5, Vector1, Vector2, Vector4,
     Vector5,
 };
+use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 use trajpred_kalman::motion::{
     KinematicLayout, StateOrder, constant_velocity, position_observation,
@@ -41,11 +42,11 @@ fn dimension_mismatches() {
     let r = kf.step(&x, Some(&DVector::zeros(3)));
     assert!(matches!(
         r,
-        Err(KalmanError::DimensionMismatch {
+        Err(KalmanError::Core(CoreError::DimensionMismatch {
             expected: 2,
             got: 3,
             ..
-        })
+        }))
     ));
     // a state of the wrong size
     let x4 = Gaussian {
@@ -54,32 +55,36 @@ fn dimension_mismatches() {
     };
     assert!(matches!(
         kf.predict(&x4),
-        Err(KalmanError::DimensionMismatch { .. })
+        Err(KalmanError::Core(CoreError::DimensionMismatch { .. }))
     ));
     // F and Q of different sizes; H with the wrong number of columns
     assert!(matches!(
         LinearTransition::new(DMatrix::<f64>::identity(3, 3), DMatrix::identity(2, 2)),
-        Err(KalmanError::DimensionMismatch { .. })
+        Err(KalmanError::Core(CoreError::DimensionMismatch { .. }))
     ));
     let bad_h =
         LinearObservation::new(DMatrix::<f64>::identity(2, 4), DMatrix::identity(2, 2)).unwrap();
     assert!(matches!(
         Kf::new(&tr, &bad_h),
-        Err(KalmanError::DimensionMismatch { .. })
+        Err(KalmanError::Core(CoreError::DimensionMismatch { .. }))
     ));
     // a static size that does not fit the number of axes
     assert!(matches!(
         constant_velocity::<f64, U5>(2, 1.0, 1.0, StateOrder::AxisBlocks),
-        Err(KalmanError::DimensionMismatch {
+        Err(KalmanError::Core(CoreError::DimensionMismatch {
             expected: 4,
             got: 5,
             ..
-        })
+        }))
     ));
-    // an innovation whose S does not match its residual
+    // an innovation whose S does not match its residual (the core Gaussian's check)
     assert!(matches!(
         Innovation::new(DVector::<f64>::zeros(2), DMatrix::identity(3, 3)),
-        Err(KalmanError::DimensionMismatch { .. })
+        Err(CoreError::DimensionMismatch {
+            expected: 2,
+            got: 3,
+            ..
+        })
     ));
     // range-bearing indices beyond the state
     let rb = RangeBearing::new(Vector2::new(0.0, 0.0), 0, 7, 1.0, 0.1).unwrap();
@@ -89,7 +94,7 @@ fn dimension_mismatches() {
             let e = ekf.unwrap();
             matches!(
                 e.update(&x, &Vector2::zeros()),
-                Err(KalmanError::DimensionMismatch { .. })
+                Err(KalmanError::Core(CoreError::DimensionMismatch { .. }))
             )
         }
     );
@@ -102,22 +107,22 @@ fn non_finite_inputs() {
     let r = kf.step(&state(), Some(&Vector2::new(f64::NAN, 0.0)));
     assert!(matches!(
         r,
-        Err(KalmanError::NonFinite {
+        Err(KalmanError::Core(CoreError::NonFinite {
             what: "observation",
             index: 0
-        })
+        }))
     ));
     let mut s = state();
     s.mean[2] = f64::INFINITY;
     assert!(matches!(
         kf.predict(&s),
-        Err(KalmanError::NonFinite { index: 2, .. })
+        Err(KalmanError::Core(CoreError::NonFinite { index: 2, .. }))
     ));
     let mut f = Matrix4::identity();
     f[(1, 1)] = f64::NAN;
     assert!(matches!(
         LinearTransition::new(f, Matrix4::identity()),
-        Err(KalmanError::NonFinite { what: "F", .. })
+        Err(KalmanError::Core(CoreError::NonFinite { what: "F", .. }))
     ));
     // overflow inside the filter is reported, never returned as inf/NaN
     let huge = Gaussian {
@@ -125,11 +130,14 @@ fn non_finite_inputs() {
         covariance: Matrix4::identity() * 1.7e308,
     };
     let r = kf.predict(&huge);
-    assert!(matches!(r, Err(KalmanError::NonFinite { .. })), "{r:?}");
+    assert!(
+        matches!(r, Err(KalmanError::Core(CoreError::NonFinite { .. }))),
+        "{r:?}"
+    );
     let ukf = Ukf::new(&tr, &ob, MerweSigmaPoints::new(0.5, 2.0, 0.0)).unwrap();
     assert!(matches!(
         ukf.update(&state(), &Vector2::new(0.0, f64::NEG_INFINITY)),
-        Err(KalmanError::NonFinite { .. })
+        Err(KalmanError::Core(CoreError::NonFinite { .. }))
     ));
 }
 
@@ -142,11 +150,15 @@ fn not_positive_definite_p_q_r_s() {
     bad.covariance = Matrix4::from_diagonal(&Vector4::new(1.0, -1.0, 1.0, 1.0));
     assert!(matches!(
         kf.predict(&bad),
-        Err(KalmanError::NotPositiveDefinite { what: "P" })
+        Err(KalmanError::Core(CoreError::NotPositiveDefinite {
+            what: "P"
+        }))
     ));
     assert!(matches!(
         kf.update(&bad, &Vector2::new(0.0, 0.0)),
-        Err(KalmanError::NotPositiveDefinite { what: "P" })
+        Err(KalmanError::Core(CoreError::NotPositiveDefinite {
+            what: "P"
+        }))
     ));
     // P with positive diagonal but indefinite (off-diagonal too large)
     bad.covariance = Matrix4::identity();
@@ -155,7 +167,9 @@ fn not_positive_definite_p_q_r_s() {
     let ukf = Ukf::new(&tr, &ob, MerweSigmaPoints::default()).unwrap();
     assert!(matches!(
         ukf.predict(&bad),
-        Err(KalmanError::NotPositiveDefinite { what: "P" })
+        Err(KalmanError::Core(CoreError::NotPositiveDefinite {
+            what: "P"
+        }))
     ));
     // P not symmetric
     bad.covariance = Matrix4::identity();
@@ -163,29 +177,52 @@ fn not_positive_definite_p_q_r_s() {
     let ekf = Ekf::new(&tr, &ob).unwrap();
     assert!(matches!(
         ekf.predict(&bad),
-        Err(KalmanError::NotPositiveDefinite { what: "P" })
+        Err(KalmanError::Core(CoreError::NotPositiveDefinite {
+            what: "P"
+        }))
     ));
     // Q indefinite
     assert!(matches!(
         LinearTransition::new(Matrix2::identity(), Matrix2::new(1.0, 0.0, 0.0, -0.5)),
-        Err(KalmanError::NotPositiveDefinite { what: "Q" })
+        Err(KalmanError::Core(CoreError::NotPositiveDefinite {
+            what: "Q"
+        }))
     ));
     // R singular (positive semi-definite is not enough for R)
     assert!(matches!(
         LinearObservation::new(Matrix1x2::new(1.0, 0.0), Matrix1::new(0.0)),
-        Err(KalmanError::NotPositiveDefinite { what: "R" })
+        Err(KalmanError::Core(CoreError::NotPositiveDefinite {
+            what: "R"
+        }))
     ));
-    // S: an innovation covariance that is not positive definite
+    // S: an innovation covariance that is not positive definite; a negative variance is
+    // refused by the Gaussian, an indefinite symmetric S by the IKF that solves with it
     assert!(matches!(
         Innovation::new(Vector1::new(1.0), Matrix1::new(-1.0)),
-        Err(KalmanError::NotPositiveDefinite { what: "S" })
+        Err(CoreError::NotPositiveDefinite { what: "covariance" })
+    ));
+    let (tr2, ob2) = (
+        LinearTransition::new(Matrix2::identity(), Matrix2::identity()).unwrap(),
+        LinearObservation::new(Matrix2::identity(), Matrix2::identity()).unwrap(),
+    );
+    let indefinite = Innovation::new(Vector2::new(1.0, 0.0), Matrix2::new(1.0, 2.0, 2.0, 1.0));
+    let prior2 = Gaussian::new(Vector2::zeros(), Matrix2::identity()).unwrap();
+    assert!(matches!(
+        Ikf::new(&tr2, &ob2)
+            .unwrap()
+            .correct(&prior2, &indefinite.unwrap()),
+        Err(KalmanError::Core(CoreError::NotPositiveDefinite {
+            what: "S"
+        }))
     ));
     // the UKF needs a strictly positive definite P for its sigma points
     let mut singular = state();
     singular.covariance[(3, 3)] = 0.0;
     assert!(matches!(
         ukf.predict(&singular),
-        Err(KalmanError::NotPositiveDefinite { what: "P" })
+        Err(KalmanError::Core(CoreError::NotPositiveDefinite {
+            what: "P"
+        }))
     ));
     // ... while the KF accepts a positive semi-definite P (a known component)
     assert!(kf.predict(&singular).is_ok());
@@ -218,9 +255,17 @@ fn kf_predict_checks_the_symmetry_of_p() {
             bad.covariance[(i, j)] = v;
             let expected = |r: &Result<Gaussian<f64, U4>, KalmanError>| {
                 if v.is_finite() {
-                    matches!(r, Err(KalmanError::NotPositiveDefinite { what: "P" }))
+                    matches!(
+                        r,
+                        Err(KalmanError::Core(CoreError::NotPositiveDefinite {
+                            what: "P"
+                        }))
+                    )
                 } else {
-                    matches!(r, Err(KalmanError::NonFinite { what: "P", .. }))
+                    matches!(
+                        r,
+                        Err(KalmanError::Core(CoreError::NonFinite { what: "P", .. }))
+                    )
                 }
             };
             let r = kf.predict(&bad);
@@ -237,7 +282,9 @@ fn kf_predict_checks_the_symmetry_of_p() {
         negative.covariance[(3, 3)] = -1.0;
         assert!(matches!(
             kf.predict(&negative),
-            Err(KalmanError::NotPositiveDefinite { what: "P" })
+            Err(KalmanError::Core(CoreError::NotPositiveDefinite {
+                what: "P"
+            }))
         ));
     }
 }
@@ -256,8 +303,7 @@ fn a_step_reports_the_errors_of_its_prediction_first() {
     let mut fast = state();
     fast.mean = Vector4::new(1.7e308, 1.7e308, 0.0, 0.0);
     for (x, what) in [(huge, "predicted covariance"), (fast, "predicted mean")] {
-        let want =
-            |r: &KalmanError| matches!(r, KalmanError::NonFinite { what: w, .. } if *w == what);
+        let want = |r: &KalmanError| matches!(r, KalmanError::Core(CoreError::NonFinite { what: w, .. }) if *w == what);
         let e = kf.predict(&x).unwrap_err();
         assert!(want(&e), "predict: {e:?}");
         let e = kf.step(&x, Some(&z)).unwrap_err();
@@ -275,10 +321,10 @@ fn a_step_reports_the_errors_of_its_prediction_first() {
     assert!(
         matches!(
             e,
-            KalmanError::NonFinite {
+            KalmanError::Core(CoreError::NonFinite {
                 what: "observation",
                 ..
-            }
+            })
         ),
         "{e:?}"
     );
@@ -331,10 +377,10 @@ fn a_prediction_that_is_not_mirrored_is_checked() {
     let predicted = |e: &KalmanError| {
         matches!(
             e,
-            KalmanError::NonFinite {
+            KalmanError::Core(CoreError::NonFinite {
                 what: "predicted covariance",
                 index: 13
-            }
+            })
         )
     };
     let e = kf.step(&state(), Some(&z)).unwrap_err();
@@ -360,7 +406,12 @@ fn s_not_positive_definite_inside_an_update() {
     };
     let r = kf.update(&x, &Vector1::new(0.0));
     assert!(
-        matches!(r, Err(KalmanError::NotPositiveDefinite { what: "S" })),
+        matches!(
+            r,
+            Err(KalmanError::Core(CoreError::NotPositiveDefinite {
+                what: "S"
+            }))
+        ),
         "{r:?}"
     );
     let _ = tr;
@@ -370,29 +421,38 @@ fn s_not_positive_definite_inside_an_update() {
 fn invalid_parameters() {
     assert!(matches!(
         constant_velocity::<f64, U4>(2, 0.0, 1.0, StateOrder::AxisBlocks),
-        Err(KalmanError::InvalidParameter { name: "dt", .. })
+        Err(KalmanError::Core(CoreError::InvalidParameter {
+            name: "dt",
+            ..
+        }))
     ));
     assert!(matches!(
         constant_velocity::<f64, nalgebra::Dyn>(4, 1.0, 1.0, StateOrder::AxisBlocks),
-        Err(KalmanError::InvalidParameter { name: "axes", .. })
+        Err(KalmanError::Core(CoreError::InvalidParameter {
+            name: "axes",
+            ..
+        }))
     ));
     assert!(matches!(
         CoordinatedTurn::<f64>::new(1.0, -1.0, 0.1),
-        Err(KalmanError::InvalidParameter {
+        Err(KalmanError::Core(CoreError::InvalidParameter {
             name: "accel_var",
             ..
-        })
+        }))
     ));
     assert!(matches!(
         RangeBearing::<f64>::new(Vector2::zeros(), 0, 1, 0.0, 0.1),
-        Err(KalmanError::InvalidParameter {
+        Err(KalmanError::Core(CoreError::InvalidParameter {
             name: "range_var",
             ..
-        })
+        }))
     ));
     assert!(matches!(
         MerweSigmaPoints::<f64>::default().weights(0),
-        Err(KalmanError::InvalidParameter { name: "n", .. })
+        Err(KalmanError::Core(CoreError::InvalidParameter {
+            name: "n",
+            ..
+        }))
     ));
 }
 
@@ -436,20 +496,31 @@ fn undefined_model_and_empty_input() {
     // smoothing nothing
     let (tr, ob) = cv();
     let kf = Kf::new(&tr, &ob).unwrap();
-    assert!(matches!(kf.smooth(&[]), Err(KalmanError::Empty { .. })));
+    assert!(matches!(
+        kf.smooth(&[]),
+        Err(KalmanError::Core(CoreError::Empty { .. }))
+    ));
     // an empty sequence filters to nothing (not an error)
     assert!(kf.filter(&state(), &[]).unwrap().is_empty());
     // the IKF reports the same checks
     let ikf = Ikf::new(&tr, &ob).unwrap();
     assert!(matches!(
         ikf.innovation(&state(), &Vector2::new(f64::NAN, 1.0)),
-        Err(KalmanError::NonFinite { .. })
+        Err(KalmanError::Core(CoreError::NonFinite { .. }))
     ));
     let _ = U5;
 }
 
 #[test]
 fn errors_convert_into_the_core_error() {
-    let e: trajpred_core::Error = KalmanError::Empty { what: "x" }.into();
-    assert!(e.to_string().contains("trajpred-kalman"));
+    // a shared variant comes back as the core error itself
+    let e: CoreError = KalmanError::Core(CoreError::Empty { what: "x" }).into();
+    assert!(matches!(e, CoreError::Empty { what: "x" }), "{e:?}");
+    // the filters' own variants are wrapped, naming the crate
+    let e: CoreError = KalmanError::Undefined { what: "bearing" }.into();
+    assert!(
+        matches!(&e, CoreError::Method { method, .. } if method == "trajpred-kalman"),
+        "{e:?}"
+    );
+    assert_eq!(e.to_string(), "trajpred-kalman: model undefined: bearing");
 }

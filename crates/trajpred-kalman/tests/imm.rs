@@ -9,6 +9,7 @@ use rand::RngExt;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
+use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 use trajpred_kalman::imm::{
     Imm, ImmState, constant_velocity_in_turn_state, coordinated_turn_continuous,
@@ -209,18 +210,21 @@ fn the_switching_matrix_is_consistent_over_time_steps() {
     assert!((1.0 - m[(0, 0)] - 1e-4).abs() < 1e-7);
     assert!(matches!(
         uniform_switching::<f64>(2, 0.0, 1.0),
-        Err(KalmanError::InvalidParameter { name: "dt", .. })
+        Err(KalmanError::Core(CoreError::InvalidParameter {
+            name: "dt",
+            ..
+        }))
     ));
     assert!(matches!(
         uniform_switching::<f64>(2, 1.0, f64::NAN),
-        Err(KalmanError::InvalidParameter {
+        Err(KalmanError::Core(CoreError::InvalidParameter {
             name: "mean_sojourn",
             ..
-        })
+        }))
     ));
     assert!(matches!(
         uniform_switching::<f64>(0, 1.0, 1.0),
-        Err(KalmanError::Empty { .. })
+        Err(KalmanError::Core(CoreError::Empty { .. }))
     ));
 }
 
@@ -236,36 +240,36 @@ fn bad_construction_gives_typed_errors() {
     let m = |v: &[f64]| DMatrix::from_row_slice(2, 2, v);
     assert!(matches!(
         Imm::new(vec![kf(), kf()], m(&[0.9, 0.2, 0.5, 0.5])),
-        Err(KalmanError::InvalidParameter {
+        Err(KalmanError::Core(CoreError::InvalidParameter {
             name: "transition matrix row",
             ..
-        })
+        }))
     ));
     assert!(matches!(
         Imm::new(vec![kf(), kf()], m(&[1.1, -0.1, 0.5, 0.5])),
-        Err(KalmanError::InvalidParameter {
+        Err(KalmanError::Core(CoreError::InvalidParameter {
             name: "transition matrix row",
             ..
-        })
+        }))
     ));
     assert!(matches!(
         Imm::new(vec![kf(), kf()], m(&[f64::NAN, 0.5, 0.5, 0.5])),
-        Err(KalmanError::NonFinite {
+        Err(KalmanError::Core(CoreError::NonFinite {
             what: "transition matrix",
             index: 0
-        })
+        }))
     ));
     assert!(matches!(
         Imm::new(vec![kf(), kf(), kf()], m(&[1.0, 0.0, 0.0, 1.0])),
-        Err(KalmanError::DimensionMismatch {
+        Err(KalmanError::Core(CoreError::DimensionMismatch {
             what: "transition matrix rows",
             expected: 3,
             got: 2
-        })
+        }))
     ));
     assert!(matches!(
         Imm::<f64, Box<dyn Filter<f64, U5, U2>>>::new(vec![], DMatrix::zeros(0, 0)),
-        Err(KalmanError::Empty { what: "IMM modes" })
+        Err(KalmanError::Core(CoreError::Empty { what: "IMM modes" }))
     ));
     // within the tolerance, rows are normalised
     let imm = Imm::new(vec![kf(), kf()], m(&[0.9 + 1e-12, 0.1, 0.5, 0.5])).expect("imm");
@@ -273,27 +277,27 @@ fn bad_construction_gives_typed_errors() {
     let g = start().modes()[0].clone();
     assert!(matches!(
         ImmState::new(vec![g.clone(), g.clone()], vec![0.5, 0.6]),
-        Err(KalmanError::InvalidParameter {
+        Err(KalmanError::Core(CoreError::InvalidParameter {
             name: "mode probabilities",
             ..
-        })
+        }))
     ));
     assert!(matches!(
         ImmState::new(vec![g.clone(), g.clone()], vec![1.0]),
-        Err(KalmanError::DimensionMismatch {
+        Err(KalmanError::Core(CoreError::DimensionMismatch {
             what: "mode probabilities",
             ..
-        })
+        }))
     ));
     // a state of three modes into an IMM of two
     let three = ImmState::uniform(g, 3).expect("state");
     assert!(matches!(
         imm.step(&three, None),
-        Err(KalmanError::DimensionMismatch {
+        Err(KalmanError::Core(CoreError::DimensionMismatch {
             what: "IMM state modes",
             expected: 2,
             got: 3
-        })
+        }))
     ));
 }
 
@@ -351,7 +355,7 @@ fn extreme_inputs_give_a_typed_error_or_a_finite_result() {
                     let Ok(c) = s.state.combined() else {
                         assert!(matches!(
                             s.state.combined(),
-                            Err(KalmanError::NonFinite { .. })
+                            Err(KalmanError::Core(CoreError::NonFinite { .. }))
                         ));
                         continue;
                     };
@@ -379,8 +383,8 @@ fn extreme_inputs_give_a_typed_error_or_a_finite_result() {
                 }
             }
             Err(
-                KalmanError::NonFinite { .. }
-                | KalmanError::NotPositiveDefinite { .. }
+                KalmanError::Core(CoreError::NonFinite { .. })
+                | KalmanError::Core(CoreError::NotPositiveDefinite { .. })
                 | KalmanError::Undefined { .. },
             ) => errors += 1,
             Err(e) => panic!("case {case}: unexpected error {e:?}"),

@@ -10,6 +10,7 @@ use rand::RngExt;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
+use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 use trajpred_kalman::motion::{
     KinematicLayout, StateOrder, constant_acceleration, constant_velocity, position_observation,
@@ -318,7 +319,12 @@ fn predict_accepts_and_rejects_p_at_every_scale() {
                     assert!(diff <= 1e-12 * size, "{eig:?} x {scale:e}: {diff:e}");
                 } else {
                     assert!(
-                        matches!(r, Err(KalmanError::NotPositiveDefinite { what: "P" })),
+                        matches!(
+                            r,
+                            Err(KalmanError::Core(CoreError::NotPositiveDefinite {
+                                what: "P"
+                            }))
+                        ),
                         "{eig:?} x {scale:e}: {r:?}"
                     );
                 }
@@ -412,6 +418,8 @@ fn two_by_two_innovation_covariance_at_every_scale() {
     };
     assert!(matches!(
         kf.update_predicted(&bad, &Vector2::zeros()),
-        Err(KalmanError::NotPositiveDefinite { what: "S" })
+        Err(KalmanError::Core(CoreError::NotPositiveDefinite {
+            what: "S"
+        }))
     ));
 }

@@ -285,7 +285,7 @@ fn ikf_hand_worked_scalar_and_causal() {
     let steps = ikf.filter(&x0, &zs).unwrap();
     assert_eq!(steps[0].corrected, steps[0].prior);
     let v = steps[0].innovation.as_ref().unwrap();
-    assert!((v.residual[0] - 2.0).abs() < 1e-15 && (v.covariance[(0, 0)] - 2.5).abs() < 1e-15);
+    assert!((v.mean[0] - 2.0).abs() < 1e-15 && (v.covariance[(0, 0)] - 2.5).abs() < 1e-15);
     assert!((steps[1].prior.covariance[(0, 0)] - 2.0).abs() < 1e-15);
     assert!((steps[1].corrected.mean[0] - 1.6).abs() < 1e-15);
     assert!((steps[1].corrected.covariance[(0, 0)] - 0.72).abs() < 1e-15);

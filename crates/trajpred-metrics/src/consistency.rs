@@ -1,29 +1,28 @@
 //! Filter consistency: NEES, NIS and their chi-square bounds.
 
+use crate::error::{check_finite, first_of_pair};
 use crate::{MetricsError, Result};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
+use trajpred_core::Error as CoreError;
 
 /// Normalised squared errors `e_i^T P_i^-1 e_i`, solved through Cholesky (no inverse).
 fn normalised_squares(errors: &[DVector<f64>], covariances: &[DMatrix<f64>]) -> Result<Vec<f64>> {
-    if errors.len() != covariances.len() {
-        return Err(MetricsError::LengthMismatch {
-            predicted: errors.len(),
-            actual: covariances.len(),
-        });
-    }
-    let dim = errors
-        .first()
-        .ok_or(MetricsError::Empty { what: "errors" })?
-        .len();
+    let dim = first_of_pair(
+        errors,
+        covariances,
+        "covariances vs error vectors",
+        "errors",
+    )?
+    .len();
     errors
         .iter()
         .zip(covariances)
         .enumerate()
         .map(|(index, (e, p))| {
             if e.len() != dim {
-                return Err(MetricsError::DimensionMismatch {
+                return Err(MetricsError::ItemDimensionMismatch {
                     what: "error vector",
                     index,
                     expected: dim,
@@ -31,7 +30,7 @@ fn normalised_squares(errors: &[DVector<f64>], covariances: &[DMatrix<f64>]) -> 
                 });
             }
             if p.nrows() != dim || p.ncols() != dim {
-                return Err(MetricsError::DimensionMismatch {
+                return Err(MetricsError::ItemDimensionMismatch {
                     what: "covariance",
                     index,
                     expected: dim,
@@ -42,22 +41,12 @@ fn normalised_squares(errors: &[DVector<f64>], covariances: &[DMatrix<f64>]) -> 
                     },
                 });
             }
-            if e.iter().any(|v| !v.is_finite()) {
-                return Err(MetricsError::NonFinite {
-                    what: "error vector",
-                    index,
-                });
-            }
-            if p.iter().any(|v| !v.is_finite()) {
-                return Err(MetricsError::NonFinite {
-                    what: "covariance",
-                    index,
-                });
-            }
+            check_finite(e, "error vector", index)?;
+            check_finite(p, "covariance", index)?;
             let chol = p
                 .clone()
                 .cholesky()
-                .ok_or(MetricsError::NotPositiveDefinite { index })?;
+                .ok_or(MetricsError::CovarianceNotPositiveDefinite { index })?;
             Ok(e.dot(&chol.solve(e)))
         })
         .collect()
@@ -96,24 +85,28 @@ pub fn nis(innovations: &[DVector<f64>], covariances: &[DMatrix<f64>]) -> Result
 /// ```
 pub fn chi_square_bounds(dof: usize, samples: usize, confidence: f64) -> Result<(f64, f64)> {
     if dof == 0 {
-        return Err(MetricsError::InvalidParameter {
-            name: "degrees of freedom",
-            value: 0.0,
-        });
+        return Err(CoreError::invalid_parameter(
+            "degrees of freedom",
+            "must be at least 1, got 0",
+        )
+        .into());
     }
     if samples == 0 {
-        return Err(MetricsError::Empty { what: "samples" });
+        return Err(CoreError::Empty { what: "samples" }.into());
     }
     if !(confidence > 0.0 && confidence < 1.0) {
-        return Err(MetricsError::InvalidParameter {
-            name: "confidence",
-            value: confidence,
-        });
+        return Err(CoreError::invalid_parameter(
+            "confidence",
+            format!("must lie in (0, 1), got {confidence}"),
+        )
+        .into());
     }
     let k = (dof * samples) as f64;
-    let chi = ChiSquared::new(k).map_err(|_| MetricsError::InvalidParameter {
-        name: "degrees of freedom",
-        value: k,
+    let chi = ChiSquared::new(k).map_err(|e| {
+        CoreError::invalid_parameter(
+            "degrees of freedom",
+            format!("{dof} x {samples} samples = {k} gives no chi-square distribution: {e}"),
+        )
     })?;
     let n = samples as f64;
     let tail = (1.0 - confidence) / 2.0;
@@ -137,10 +130,11 @@ pub struct Consistency {
 /// lies inside the two-sided `confidence` chi-square interval of [`chi_square_bounds`].
 pub fn consistency(values: &[f64], dof: usize, confidence: f64) -> Result<Consistency> {
     if let Some(index) = values.iter().position(|v| !v.is_finite() || *v < 0.0) {
-        return Err(MetricsError::NonFinite {
-            what: "values",
+        return Err(CoreError::NonFinite {
+            what: "values (or a negative value)",
             index,
-        });
+        }
+        .into());
     }
     let (lower, upper) = chi_square_bounds(dof, values.len(), confidence)?;
     let mean = values.iter().sum::<f64>() / values.len() as f64;

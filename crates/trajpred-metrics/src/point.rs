@@ -1,52 +1,36 @@
 //! Point-wise error measures.
 
+use crate::error::{check_finite, first_of_pair};
 use crate::{MetricsError, Result};
 use serde::{Deserialize, Serialize};
+use trajpred_core::Error as CoreError;
 
 /// Checks a (predicted, actual) pair of point lists and returns the common number of axes.
 fn check<P: AsRef<[f64]>, Q: AsRef<[f64]>>(predicted: &[P], actual: &[Q]) -> Result<usize> {
-    if predicted.len() != actual.len() {
-        return Err(MetricsError::LengthMismatch {
-            predicted: predicted.len(),
-            actual: actual.len(),
-        });
-    }
-    let first = predicted
-        .first()
-        .ok_or(MetricsError::Empty { what: "points" })?;
+    let first = first_of_pair(
+        predicted,
+        actual,
+        "actual points vs predicted points",
+        "points",
+    )?;
     let dim = first.as_ref().len();
     if dim == 0 {
-        return Err(MetricsError::DimensionMismatch {
-            what: "point",
-            index: 0,
-            expected: 1,
-            got: 0,
-        });
+        return Err(CoreError::Empty { what: "point 0" }.into());
     }
     for (index, (p, a)) in predicted.iter().zip(actual).enumerate() {
         let (p, a) = (p.as_ref(), a.as_ref());
-        for (got, _) in [(p.len(), "predicted"), (a.len(), "actual")] {
+        for got in [p.len(), a.len()] {
             if got != dim {
-                return Err(MetricsError::DimensionMismatch {
-                    what: "point",
+                return Err(CoreError::PointDimension {
                     index,
                     expected: dim,
                     got,
-                });
+                }
+                .into());
             }
         }
-        if p.iter().any(|v| !v.is_finite()) {
-            return Err(MetricsError::NonFinite {
-                what: "predicted",
-                index,
-            });
-        }
-        if a.iter().any(|v| !v.is_finite()) {
-            return Err(MetricsError::NonFinite {
-                what: "actual",
-                index,
-            });
-        }
+        check_finite(p, "predicted", index)?;
+        check_finite(a, "actual", index)?;
     }
     Ok(dim)
 }
@@ -112,12 +96,12 @@ pub fn rms_euclidean_error<P: AsRef<[f64]>, Q: AsRef<[f64]>>(
 pub fn rmse_3d<P: AsRef<[f64]>, Q: AsRef<[f64]>>(predicted: &[P], actual: &[Q]) -> Result<f64> {
     let dim = check(predicted, actual)?;
     if dim != 3 {
-        return Err(MetricsError::DimensionMismatch {
-            what: "point",
-            index: 0,
+        return Err(CoreError::DimensionMismatch {
+            what: "point axes (rmse_3d)",
             expected: 3,
             got: dim,
-        });
+        }
+        .into());
     }
     rms_euclidean_error(predicted, actual)
 }
@@ -140,10 +124,11 @@ pub fn hit_rate<P: AsRef<[f64]>, Q: AsRef<[f64]>>(
     threshold: f64,
 ) -> Result<f64> {
     if !(threshold.is_finite() && threshold > 0.0) {
-        return Err(MetricsError::InvalidParameter {
-            name: "threshold",
-            value: threshold,
-        });
+        return Err(CoreError::invalid_parameter(
+            "threshold",
+            format!("must be finite and positive, got {threshold}"),
+        )
+        .into());
     }
     let errors = euclidean_errors(predicted, actual)?;
     let hits = errors.iter().filter(|&&e| e < threshold).count();
@@ -242,18 +227,10 @@ where
     P: AsRef<[f64]>,
     Q: AsRef<[f64]>,
 {
-    if forecasts.len() != actual.len() {
-        return Err(MetricsError::LengthMismatch {
-            predicted: forecasts.len(),
-            actual: actual.len(),
-        });
-    }
-    let first = forecasts
-        .first()
-        .ok_or(MetricsError::Empty { what: "forecasts" })?;
+    let first = first_of_pair(forecasts, actual, "actual tracks vs forecasts", "forecasts")?;
     let horizon = first.as_ref().len();
     if horizon == 0 {
-        return Err(MetricsError::Empty { what: "forecast 0" });
+        return Err(CoreError::Empty { what: "forecast 0" }.into());
     }
     let mut sum = vec![0.0; horizon];
     let mut sum_sq = vec![0.0; horizon];
@@ -262,7 +239,7 @@ where
         let (f, a) = (f.as_ref(), a.as_ref());
         for got in [f.len(), a.len()] {
             if got != horizon {
-                return Err(MetricsError::DimensionMismatch {
+                return Err(MetricsError::ItemDimensionMismatch {
                     what: "forecast",
                     index,
                     expected: horizon,
@@ -272,9 +249,11 @@ where
         }
         let d = check(f, a).map_err(|e| match e {
             // report the forecast index, not the step index
-            MetricsError::NonFinite { what, .. } => MetricsError::NonFinite { what, index },
-            MetricsError::DimensionMismatch { expected, got, .. } => {
-                MetricsError::DimensionMismatch {
+            MetricsError::Core(CoreError::NonFinite { what, .. }) => {
+                CoreError::NonFinite { what, index }.into()
+            }
+            MetricsError::Core(CoreError::PointDimension { expected, got, .. }) => {
+                MetricsError::ItemDimensionMismatch {
                     what: "forecast point",
                     index,
                     expected,
@@ -285,7 +264,7 @@ where
         })?;
         let d0 = *dim.get_or_insert(d);
         if d != d0 {
-            return Err(MetricsError::DimensionMismatch {
+            return Err(MetricsError::ItemDimensionMismatch {
                 what: "forecast point",
                 index,
                 expected: d0,

@@ -5,7 +5,7 @@
 //! multi-step outputs `[batch, T * features]`.
 
 use crate::config::{Activation, TrainConfig};
-use crate::error::{NeuralError, Result};
+use crate::error::{CoreError, NeuralError, Result};
 use burn::module::Module;
 use burn::nn::{Linear, LinearConfig, Rnn, RnnConfig};
 use burn::tensor::activation::{relu, sigmoid, tanh};
@@ -60,24 +60,24 @@ pub const MAX_LAYERS: usize = 16;
 
 pub(crate) fn check_sizes(name: &'static str, sizes: &[usize], need_one: bool) -> Result<()> {
     if sizes.len() > MAX_LAYERS || sizes.iter().any(|&w| w > MAX_LAYER_WIDTH) {
-        return Err(NeuralError::InvalidConfig {
+        return Err(NeuralError::Core(CoreError::InvalidParameter {
             name,
             reason: format!(
                 "at most {MAX_LAYERS} layers of at most {MAX_LAYER_WIDTH} units (got {sizes:?})"
             ),
-        });
+        }));
     }
     if need_one && sizes.is_empty() {
-        return Err(NeuralError::InvalidConfig {
+        return Err(NeuralError::Core(CoreError::InvalidParameter {
             name,
-            reason: "needs at least one layer".into(),
-        });
+            reason: format!("needs at least one layer, got {sizes:?}"),
+        }));
     }
     if sizes.contains(&0) {
-        return Err(NeuralError::InvalidConfig {
+        return Err(NeuralError::Core(CoreError::InvalidParameter {
             name,
-            reason: "layer sizes must be at least 1".into(),
-        });
+            reason: format!("layer sizes must be at least 1, got {sizes:?}"),
+        }));
     }
     Ok(())
 }

@@ -1,6 +1,6 @@
 //! Training configuration, per-epoch reports and the small enums shared by every model.
 
-use crate::error::{NeuralError, Result};
+use crate::error::{CoreError, Result};
 use serde::{Deserialize, Serialize};
 use std::time::Duration;
 
@@ -129,50 +129,60 @@ impl TrainConfig {
 
     /// Checks every field.
     pub fn validate(&self) -> Result<()> {
-        let bad = |name: &'static str, reason: &str| {
-            Err(NeuralError::InvalidConfig {
-                name,
-                reason: reason.to_string(),
-            })
+        let bad = |name: &'static str, reason: &str, value: &dyn std::fmt::Display| {
+            Err(CoreError::invalid_parameter(name, format!("{reason}, got {value}")).into())
         };
         if self.epochs == 0 {
-            return bad("epochs", "must be at least 1");
+            return bad("epochs", "must be at least 1", &self.epochs);
         }
         if self.batch_size == 0 {
-            return bad("batch_size", "must be at least 1");
+            return bad("batch_size", "must be at least 1", &self.batch_size);
         }
         if !(self.learning_rate.is_finite() && self.learning_rate > 0.0) {
-            return bad("learning_rate", "must be finite and positive");
+            return bad(
+                "learning_rate",
+                "must be finite and positive",
+                &self.learning_rate,
+            );
         }
         match self.optimizer {
             Optimizer::Adam { epsilon } if !(epsilon.is_finite() && epsilon > 0.0) => {
-                return bad("optimizer.epsilon", "must be finite and positive");
+                return bad("optimizer.epsilon", "must be finite and positive", &epsilon);
             }
             Optimizer::Sgd { momentum }
                 if !(momentum.is_finite() && (0.0..1.0).contains(&momentum)) =>
             {
-                return bad("optimizer.momentum", "must lie in [0, 1)");
+                return bad("optimizer.momentum", "must lie in [0, 1)", &momentum);
             }
             _ => {}
         }
         if let Some(es) = &self.early_stopping {
             if !(es.validation_fraction > 0.0 && es.validation_fraction < 1.0) {
-                return bad("early_stopping.validation_fraction", "must lie in (0, 1)");
+                return bad(
+                    "early_stopping.validation_fraction",
+                    "must lie in (0, 1)",
+                    &es.validation_fraction,
+                );
             }
             if es.patience == 0 {
-                return bad("early_stopping.patience", "must be at least 1");
+                return bad(
+                    "early_stopping.patience",
+                    "must be at least 1",
+                    &es.patience,
+                );
             }
             if !(es.min_delta.is_finite() && es.min_delta >= 0.0) {
                 return bad(
                     "early_stopping.min_delta",
                     "must be finite and non-negative",
+                    &es.min_delta,
                 );
             }
         }
         if let Some(c) = self.grad_clip_norm
             && !(c.is_finite() && c > 0.0)
         {
-            return bad("grad_clip_norm", "must be finite and positive");
+            return bad("grad_clip_norm", "must be finite and positive", &c);
         }
         Ok(())
     }

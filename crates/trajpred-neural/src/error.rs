@@ -1,49 +1,28 @@
 //! The error type of `trajpred-neural`.
 
 use thiserror::Error;
+pub(crate) use trajpred_core::Error as CoreError;
 
 /// Everything that can go wrong while building, training, running, saving or loading a
-/// neural predictor. Converted into [`trajpred_core::Error::Method`] by the
-/// [`Predictor`](trajpred_core::Predictor) implementations.
+/// neural predictor. The [`Predictor`](trajpred_core::Predictor) implementations convert it
+/// into [`trajpred_core::Error`]: a shared variant as itself, the others wrapped in
+/// [`trajpred_core::Error::Method`].
+///
+/// The input errors every crate shares are [`trajpred_core::Error`]'s variants, wrapped in
+/// [`NeuralError::Core`]: match them as
+/// `NeuralError::Core(trajpred_core::Error::TooShort { .. })`. The variants declared here are
+/// the networks' own.
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum NeuralError {
-    /// A series, a history or the training set is too short for the configured window.
-    #[error("{what} too short: needs at least {needed} points, got {got}")]
-    TooShort {
-        /// What is too short.
-        what: &'static str,
-        /// The minimum number of points.
-        needed: usize,
-        /// The number of points given.
-        got: usize,
-    },
-    /// A value is NaN or infinite.
-    #[error("non-finite value in {what} at index {index}")]
-    NonFinite {
-        /// Which input held the value.
-        what: &'static str,
-        /// Index of the first non-finite value.
-        index: usize,
-    },
-    /// An input has the wrong number of axes or values.
-    #[error("dimension mismatch in {what}: expected {expected}, got {got}")]
-    DimensionMismatch {
-        /// Where the mismatch was found.
-        what: &'static str,
-        /// The required dimension.
-        expected: usize,
-        /// The given dimension.
-        got: usize,
-    },
-    /// A configuration value outside its valid domain.
-    #[error("invalid configuration `{name}`: {reason}")]
-    InvalidConfig {
-        /// The parameter's name.
-        name: &'static str,
-        /// Why it is invalid.
-        reason: String,
-    },
+    /// An input error shared with the other crates (see [`trajpred_core::Error`]):
+    /// `TooShort` (a series, a history or the training set too short for the configured
+    /// window), `NonFinite` (a NaN or infinite value, with its index), `DimensionMismatch`
+    /// (an input with the wrong number of axes or values) and `InvalidParameter` (a
+    /// configuration value outside its domain, with the value). Its message is the core
+    /// error's.
+    #[error(transparent)]
+    Core(#[from] trajpred_core::Error),
     /// No training data was given.
     #[error("no training data: {what}")]
     NoTrainingData {
@@ -78,28 +57,20 @@ pub enum NeuralError {
 }
 
 impl NeuralError {
-    /// Converts into the workspace error, naming the method.
+    /// Converts into the workspace error, naming the method: a shared variant comes back as
+    /// the core error itself, [`NeuralError::NotFitted`] as
+    /// [`trajpred_core::Error::NotFitted`], the rest as [`trajpred_core::Error::Method`].
     pub(crate) fn into_core(self, method: &str) -> trajpred_core::Error {
         match self {
-            NeuralError::TooShort { what, needed, got } => {
-                trajpred_core::Error::TooShort { what, needed, got }
-            }
-            NeuralError::DimensionMismatch {
-                what,
-                expected,
-                got,
-            } => trajpred_core::Error::DimensionMismatch {
-                what,
-                expected,
-                got,
-            },
             NeuralError::NotFitted => trajpred_core::Error::NotFitted {
                 method: method.to_string(),
             },
-            other => trajpred_core::Error::method(method, other),
+            other => trajpred_core::Error::from_crate(method, other),
         }
     }
 }
 
 /// `Result` with [`NeuralError`].
 pub type Result<T, E = NeuralError> = std::result::Result<T, E>;
+
+trajpred_core::crate_error!(NeuralError, "trajpred-neural");

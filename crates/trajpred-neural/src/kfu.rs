@@ -7,7 +7,7 @@
 
 use crate::arch::{FusedLstm, Head, LstmCellState};
 use crate::config::{Activation, EpochReport, TrainConfig, TrainReport};
-use crate::error::{NeuralError, Result};
+use crate::error::{CoreError, NeuralError, Result};
 use crate::fused::{self, kfu::Spec};
 use crate::persist;
 use crate::train::{
@@ -92,28 +92,33 @@ impl Default for KfuConfig {
 impl KfuConfig {
     /// Checks every field.
     pub fn validate(&self) -> Result<()> {
-        let bad = |name: &'static str, reason: &str| {
-            Err(NeuralError::InvalidConfig {
-                name,
-                reason: reason.to_string(),
-            })
+        let bad = |name: &'static str, reason: &str, value: &dyn std::fmt::Display| {
+            Err(CoreError::invalid_parameter(name, format!("{reason}, got {value}")).into())
         };
         crate::arch::check_sizes("layers", &self.layers, true)?;
         crate::arch::check_sizes("fc", &self.fc, false)?;
         if !(self.init_log_q.is_finite() && self.init_log_r.is_finite()) {
-            return bad("init_log_q/init_log_r", "must be finite");
+            return bad(
+                "init_log_q/init_log_r",
+                "must be finite",
+                &format!("{} / {}", self.init_log_q, self.init_log_r),
+            );
         }
         if !(self.p0.is_finite() && self.p0 > 0.0) {
-            return bad("p0", "must be finite and positive");
+            return bad("p0", "must be finite and positive", &self.p0);
         }
         if !(self.noise_learning_rate.is_finite() && self.noise_learning_rate >= 0.0) {
-            return bad("noise_learning_rate", "must be finite and non-negative");
+            return bad(
+                "noise_learning_rate",
+                "must be finite and non-negative",
+                &self.noise_learning_rate,
+            );
         }
         if !(3..=MAX_SEQ_LEN).contains(&self.seq_len) {
-            return bad("seq_len", "must lie in 3..=100000");
+            return bad("seq_len", "must lie in 3..=100000", &self.seq_len);
         }
         if self.stride == 0 {
-            return bad("stride", "must be at least 1");
+            return bad("stride", "must be at least 1", &self.stride);
         }
         Ok(())
     }
@@ -419,26 +424,26 @@ impl KfuLstmNet {
         progress: &mut dyn FnMut(&EpochReport),
     ) -> Result<&TrainReport> {
         if observed.len() != truth.len() {
-            return Err(NeuralError::DimensionMismatch {
+            return Err(NeuralError::Core(CoreError::DimensionMismatch {
                 what: "number of truth trajectories",
                 expected: observed.len(),
                 got: truth.len(),
-            });
+            }));
         }
         for (o, t) in observed.iter().zip(truth) {
             if o.len() != t.len() {
-                return Err(NeuralError::DimensionMismatch {
+                return Err(NeuralError::Core(CoreError::DimensionMismatch {
                     what: "truth trajectory length",
                     expected: o.len(),
                     got: t.len(),
-                });
+                }));
             }
             if o.dim() != t.dim() {
-                return Err(NeuralError::DimensionMismatch {
+                return Err(NeuralError::Core(CoreError::DimensionMismatch {
                     what: "truth trajectory axes",
                     expected: o.dim(),
                     got: t.dim(),
-                });
+                }));
             }
         }
         self.fit_inner(observed, Some(truth), progress)
@@ -463,11 +468,11 @@ impl KfuLstmNet {
         let dim = common_dim(observed)?;
         let shortest = observed.iter().map(Trajectory::len).min().unwrap_or(0);
         if shortest < 3 {
-            return Err(NeuralError::TooShort {
-                what: "shortest training trajectory",
+            return Err(NeuralError::Core(CoreError::TooShort {
+                what: "shortest training trajectory (in points)",
                 needed: 3,
                 got: shortest,
-            });
+            }));
         }
         let series: Vec<Vec<&[f64]>> = observed.iter().map(series_of).collect();
         let scaler = Standardizer::fit(&series, dim);
@@ -573,24 +578,24 @@ impl KfuLstmNet {
         let (f, cell) = self.cell()?;
         let dim = f.dim;
         if history.is_empty() {
-            return Err(NeuralError::TooShort {
-                what: "history",
+            return Err(NeuralError::Core(CoreError::TooShort {
+                what: "history (in points)",
                 needed: 1,
                 got: 0,
-            });
+            }));
         }
         let c = history.len().min(self.config.seq_len);
         let recent = &history[history.len() - c..];
         let mut z = Vec::with_capacity(c * dim);
         for (i, p) in recent.iter().enumerate() {
             if p.len() != dim {
-                return Err(NeuralError::DimensionMismatch {
+                return Err(NeuralError::Core(CoreError::DimensionMismatch {
                     what: "history point axes",
                     expected: dim,
                     got: p.len(),
-                });
+                }));
             }
-            check_finite("history", p).map_err(|_| NeuralError::NonFinite {
+            check_finite("history", p).map_err(|_| CoreError::NonFinite {
                 what: "history",
                 index: history.len() - c + i,
             })?;
@@ -610,10 +615,10 @@ impl KfuLstmNet {
                 .map(|k| f.scaler.inverse(k, f64::from(v[k])))
                 .collect();
             if p.iter().any(|x| !x.is_finite()) {
-                return Err(NeuralError::NonFinite {
+                return Err(NeuralError::Core(CoreError::NonFinite {
                     what: "network output",
                     index: s,
-                });
+                }));
             }
             out.push(p);
         }
@@ -628,19 +633,19 @@ impl KfuLstmNet {
         let (f, cell) = self.cell()?;
         let dim = f.dim;
         if observed.dim() != dim {
-            return Err(NeuralError::DimensionMismatch {
+            return Err(NeuralError::Core(CoreError::DimensionMismatch {
                 what: "trajectory axes",
                 expected: dim,
                 got: observed.dim(),
-            });
+            }));
         }
         let n = observed.len();
         if n < 2 {
-            return Err(NeuralError::TooShort {
-                what: "trajectory",
+            return Err(NeuralError::Core(CoreError::TooShort {
+                what: "trajectory (in points)",
                 needed: 2,
                 got: n,
-            });
+            }));
         }
         let l = self.config.seq_len;
         let spec = self.spec(dim);
@@ -688,10 +693,10 @@ impl KfuLstmNet {
             }
         }
         if let Some(i) = out.iter().position(|p| p.iter().any(|x| !x.is_finite())) {
-            return Err(NeuralError::NonFinite {
+            return Err(NeuralError::Core(CoreError::NonFinite {
                 what: "network output",
                 index: i,
-            });
+            }));
         }
         Ok(out)
     }

@@ -2,7 +2,7 @@
 //! tensor read-back and the mini-batch training loop with early stopping.
 
 use crate::config::{EpochReport, Optimizer, Progress, TrainConfig, TrainReport};
-use crate::error::{NeuralError, Result};
+use crate::error::{CoreError, NeuralError, Result};
 use crate::fused::adam::FusedAdam;
 use burn::grad_clipping::GradientClippingConfig;
 use burn::lr_scheduler::module_lr_scheduler::ModuleLrScheduler;
@@ -278,11 +278,11 @@ pub(crate) fn common_dim(train: &[Trajectory]) -> Result<usize> {
             what: "no training trajectories",
         })?;
     if let Some(t) = train.iter().find(|t| t.dim() != dim) {
-        return Err(NeuralError::DimensionMismatch {
+        return Err(NeuralError::Core(CoreError::DimensionMismatch {
             what: "training trajectory axes",
             expected: dim,
             got: t.dim(),
-        });
+        }));
     }
     Ok(dim)
 }
@@ -290,7 +290,7 @@ pub(crate) fn common_dim(train: &[Trajectory]) -> Result<usize> {
 /// Checks that every value of a raw series is finite.
 pub(crate) fn check_finite(what: &'static str, values: &[f64]) -> Result<()> {
     match values.iter().position(|v| !v.is_finite()) {
-        Some(index) => Err(NeuralError::NonFinite { what, index }),
+        Some(index) => Err(NeuralError::Core(CoreError::NonFinite { what, index })),
         None => Ok(()),
     }
 }

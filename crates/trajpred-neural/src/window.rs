@@ -4,7 +4,7 @@
 
 use crate::arch::{Architecture, LstmArch, MlpArch, RecurrentLayers, RnnArch};
 use crate::config::{Activation, AxisMode, EpochReport, Optimizer, TrainConfig, TrainReport};
-use crate::error::{NeuralError, Result};
+use crate::error::{CoreError, NeuralError, Result};
 use crate::persist;
 use crate::train::{
     LoopSpec, Standardizer, XavierZeroBias, check_finite, common_dim, device, read, rng, train_loop,
@@ -43,10 +43,10 @@ impl WindowConfig {
     pub fn validate(&self) -> Result<()> {
         for (name, v) in [("window", self.window), ("horizon", self.horizon)] {
             if !(1..=MAX_WINDOW).contains(&v) {
-                return Err(NeuralError::InvalidConfig {
+                return Err(NeuralError::Core(CoreError::InvalidParameter {
                     name,
                     reason: format!("must lie in 1..={MAX_WINDOW}, got {v}"),
-                });
+                }));
             }
         }
         Ok(())
@@ -244,19 +244,19 @@ impl<A: Architecture> WindowNet<A> {
         progress: &mut dyn FnMut(&EpochReport),
     ) -> Result<&[TrainReport]> {
         if inputs.len() != targets.len() {
-            return Err(NeuralError::DimensionMismatch {
+            return Err(NeuralError::Core(CoreError::DimensionMismatch {
                 what: "number of target trajectories",
                 expected: inputs.len(),
                 got: targets.len(),
-            });
+            }));
         }
         for (i, t) in inputs.iter().zip(targets) {
             if i.len() != t.len() || i.dim() != t.dim() {
-                return Err(NeuralError::DimensionMismatch {
+                return Err(NeuralError::Core(CoreError::DimensionMismatch {
                     what: "target trajectory length x axes",
                     expected: i.len() * i.dim(),
                     got: t.len() * t.dim(),
-                });
+                }));
             }
         }
         self.fit_inner(inputs, Some(targets), progress)
@@ -272,11 +272,11 @@ impl<A: Architecture> WindowNet<A> {
         let (m, h) = (self.layout.window, self.layout.horizon);
         let longest = train.iter().map(Trajectory::len).max().unwrap_or(0);
         if longest < m + h {
-            return Err(NeuralError::TooShort {
-                what: "longest training trajectory",
+            return Err(NeuralError::Core(CoreError::TooShort {
+                what: "longest training trajectory (in points)",
                 needed: m + h,
                 got: longest,
-            });
+            }));
         }
         let series: Vec<Vec<&[f64]>> = train
             .iter()
@@ -452,21 +452,21 @@ impl<A: Architecture> WindowNet<A> {
         let (fitted, nets) = self.nets()?;
         let (m, h, dim) = (self.layout.window, self.layout.horizon, fitted.dim);
         if window.len() != m {
-            return Err(NeuralError::DimensionMismatch {
+            return Err(NeuralError::Core(CoreError::DimensionMismatch {
                 what: "window length",
                 expected: m,
                 got: window.len(),
-            });
+            }));
         }
         for (i, p) in window.iter().enumerate() {
             if p.len() != dim {
-                return Err(NeuralError::DimensionMismatch {
+                return Err(NeuralError::Core(CoreError::DimensionMismatch {
                     what: "window point axes",
                     expected: dim,
                     got: p.len(),
-                });
+                }));
             }
-            check_finite("window", p).map_err(|_| NeuralError::NonFinite {
+            check_finite("window", p).map_err(|_| CoreError::NonFinite {
                 what: "window",
                 index: i,
             })?;
@@ -501,10 +501,10 @@ impl<A: Architecture> WindowNet<A> {
             }
         }
         if let Some(i) = outp.iter().position(|p| p.iter().any(|v| !v.is_finite())) {
-            return Err(NeuralError::NonFinite {
+            return Err(NeuralError::Core(CoreError::NonFinite {
                 what: "network output",
                 index: i,
-            });
+            }));
         }
         Ok(outp)
     }
@@ -514,11 +514,11 @@ impl<A: Architecture> WindowNet<A> {
     pub fn predict_series(&self, history: &[Vec<f64>], horizon: usize) -> Result<Vec<Vec<f64>>> {
         let m = self.layout.window;
         if history.len() < m {
-            return Err(NeuralError::TooShort {
-                what: "history",
+            return Err(NeuralError::Core(CoreError::TooShort {
+                what: "history (in points)",
                 needed: m,
                 got: history.len(),
-            });
+            }));
         }
         let mut window: Vec<Vec<f64>> = history[history.len() - m..].to_vec();
         let mut out = Vec::with_capacity(horizon);

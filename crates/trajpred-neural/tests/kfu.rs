@@ -2,7 +2,7 @@
 //! finite difference, training, reproducibility, batched one-step-ahead = per-origin forecast,
 //! save/load, typed errors.
 
-use trajpred_core::{Predictor, Trajectory};
+use trajpred_core::{Error as CoreError, Predictor, Trajectory};
 use trajpred_neural::burn::tensor::{Device, Tensor, TensorData};
 use trajpred_neural::{KfuConfig, KfuLstmNet, NeuralError, TrainConfig, kalman_update};
 
@@ -296,42 +296,42 @@ fn kfu_save_load_and_typed_errors() {
     assert!(matches!(m.noise(), Err(NeuralError::NotFitted)));
     assert!(matches!(
         m.fit_supervised(&[noisy(30, 0.0)], &[], &mut |_| {}),
-        Err(NeuralError::DimensionMismatch { .. })
+        Err(NeuralError::Core(CoreError::DimensionMismatch { .. }))
     ));
     assert!(matches!(
         m.fit_supervised(&[noisy(30, 0.0)], &[clean(29, 0.0)], &mut |_| {}),
-        Err(NeuralError::DimensionMismatch {
+        Err(NeuralError::Core(CoreError::DimensionMismatch {
             expected: 30,
             got: 29,
             ..
-        })
+        }))
     ));
     assert!(matches!(
         m.fit_observed(&[noisy(2, 0.0)], &mut |_| {}),
-        Err(NeuralError::TooShort {
+        Err(NeuralError::Core(CoreError::TooShort {
             needed: 3,
             got: 2,
             ..
-        })
+        }))
     ));
     m.fit(&[noisy(30, 0.0)]).unwrap();
     let mut h = vec![vec![0.1, 0.2, 0.3]; 6];
     h[4][0] = f64::INFINITY;
     assert!(matches!(
         m.predict_series(&h, 1),
-        Err(NeuralError::NonFinite { index: 4, .. })
+        Err(NeuralError::Core(CoreError::NonFinite { index: 4, .. }))
     ));
     assert!(matches!(
         m.predict_series(&[vec![0.0; 2]], 1),
-        Err(NeuralError::DimensionMismatch {
+        Err(NeuralError::Core(CoreError::DimensionMismatch {
             expected: 3,
             got: 2,
             ..
-        })
+        }))
     ));
     assert!(matches!(
         m.predict_series(&[], 1),
-        Err(NeuralError::TooShort { .. })
+        Err(NeuralError::Core(CoreError::TooShort { .. }))
     ));
     let dir = std::env::temp_dir().join(format!("trajpred-kfu-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -358,9 +358,9 @@ fn kfu_save_load_and_typed_errors() {
             },
             TrainConfig::new(1e-3)
         ),
-        Err(NeuralError::InvalidConfig {
+        Err(NeuralError::Core(CoreError::InvalidParameter {
             name: "seq_len",
             ..
-        })
+        }))
     ));
 }

@@ -1,7 +1,7 @@
 //! Behaviour of the trained models: the loss falls, runs are reproducible, forecasts are
 //! causal (and the causality check catches a leak), models save and load, bad input gives typed errors.
 
-use trajpred_core::{Forecast, Predictor, Trajectory};
+use trajpred_core::{Error as CoreError, Forecast, Predictor, Trajectory};
 use trajpred_neural::{
     AxisMode, EarlyStopping, LstmArch, LstmNet, Mlp, MlpArch, NeuralError, RecurrentLayers,
     RnnArch, RnnNet, TrainConfig, TrainReport, WindowConfig, WindowNet,
@@ -326,11 +326,11 @@ fn bad_input_gives_typed_errors() {
     // too short to make one window + horizon
     assert!(matches!(
         m.fit_with(&[curve(6, 0.0)], &mut |_| {}),
-        Err(NeuralError::TooShort {
+        Err(NeuralError::Core(CoreError::TooShort {
             needed: 7,
             got: 6,
             ..
-        })
+        }))
     ));
     // no data
     assert!(matches!(
@@ -341,11 +341,11 @@ fn bad_input_gives_typed_errors() {
     let two_d = Trajectory::uniform(0.0, 1.0, vec![vec![0.0; 20], vec![1.0; 20]]).unwrap();
     assert!(matches!(
         m.fit_with(&[curve(20, 0.0), two_d.clone()], &mut |_| {}),
-        Err(NeuralError::DimensionMismatch {
+        Err(NeuralError::Core(CoreError::DimensionMismatch {
             expected: 3,
             got: 2,
             ..
-        })
+        }))
     ));
     m.fit(&[curve(20, 0.0)]).unwrap();
     // NaN in a raw window
@@ -353,24 +353,24 @@ fn bad_input_gives_typed_errors() {
     w[2][1] = f64::NAN;
     assert!(matches!(
         m.predict_window(&w),
-        Err(NeuralError::NonFinite { index: 2, .. })
+        Err(NeuralError::Core(CoreError::NonFinite { index: 2, .. }))
     ));
     // wrong point dimension, wrong window length
     assert!(matches!(
         m.predict_window(&vec![vec![0.0; 2]; 5]),
-        Err(NeuralError::DimensionMismatch {
+        Err(NeuralError::Core(CoreError::DimensionMismatch {
             expected: 3,
             got: 2,
             ..
-        })
+        }))
     ));
     assert!(matches!(
         m.predict_window(&vec![vec![0.0; 3]; 4]),
-        Err(NeuralError::DimensionMismatch {
+        Err(NeuralError::Core(CoreError::DimensionMismatch {
             expected: 5,
             got: 4,
             ..
-        })
+        }))
     ));
     // through the Predictor trait: history too short, wrong dimension
     assert!(matches!(
@@ -396,7 +396,10 @@ fn bad_input_gives_typed_errors() {
             layout(AxisMode::Joint),
             cfg.clone().with_epochs(0)
         ),
-        Err(NeuralError::InvalidConfig { name: "epochs", .. })
+        Err(NeuralError::Core(CoreError::InvalidParameter {
+            name: "epochs",
+            ..
+        }))
     ));
     assert!(matches!(
         WindowNet::new(
@@ -408,7 +411,10 @@ fn bad_input_gives_typed_errors() {
             },
             cfg.clone()
         ),
-        Err(NeuralError::InvalidConfig { name: "window", .. })
+        Err(NeuralError::Core(CoreError::InvalidParameter {
+            name: "window",
+            ..
+        }))
     ));
     assert!(matches!(
         WindowNet::new(
@@ -419,7 +425,10 @@ fn bad_input_gives_typed_errors() {
             layout(AxisMode::Joint),
             cfg.clone()
         ),
-        Err(NeuralError::InvalidConfig { name: "layers", .. })
+        Err(NeuralError::Core(CoreError::InvalidParameter {
+            name: "layers",
+            ..
+        }))
     ));
     assert!(matches!(
         WindowNet::new(
@@ -427,10 +436,10 @@ fn bad_input_gives_typed_errors() {
             layout(AxisMode::Joint),
             cfg.with_learning_rate(f64::NAN)
         ),
-        Err(NeuralError::InvalidConfig {
+        Err(NeuralError::Core(CoreError::InvalidParameter {
             name: "learning_rate",
             ..
-        })
+        }))
     ));
 }
 
@@ -555,10 +564,10 @@ fn fit_targets_trains_on_the_given_targets() {
             std::slice::from_ref(&short),
             &mut |_| {}
         ),
-        Err(NeuralError::DimensionMismatch { .. })
+        Err(NeuralError::Core(CoreError::DimensionMismatch { .. }))
     ));
     assert!(matches!(
         n.fit_targets(std::slice::from_ref(&x), &[], &mut |_| {}),
-        Err(NeuralError::DimensionMismatch { .. })
+        Err(NeuralError::Core(CoreError::DimensionMismatch { .. }))
     ));
 }

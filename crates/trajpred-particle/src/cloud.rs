@@ -2,13 +2,13 @@
 //! covariance, quantiles, effective sample size).
 
 use crate::error::{ParticleError, Result};
-use crate::gauss::{first_non_finite, psd_factor, push_normals, shifted};
 use crate::weights::{effective_sample_size_log, normalize_log_weights};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
 use rand::Rng;
 use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
+use trajpred_kalman::sampling::{covariance_sqrt, draw, push_standard_normals};
 
 /// Weighted particles `{x_i, w_i}`: the empirical approximation
 /// `p(x) ~ sum_i w_i delta(x - x_i)` (`docs/papers.md` C eq. 2), with the weights kept in log space
@@ -108,13 +108,13 @@ where
             }
             .into());
         }
-        let l = psd_factor(&initial.covariance, "P")?;
+        let l = covariance_sqrt(&initial.covariance, "P")?;
         let mut noise: Vec<T> = Vec::new();
-        push_normals(rng, n * dim, &mut noise);
+        push_standard_normals(rng, n * dim, &mut noise);
         let particles = noise
             .chunks(dim.max(1))
             .take(n)
-            .map(|e| shifted(&initial.mean, &l, e))
+            .map(|e| draw(&initial.mean, &l, e.iter().copied()))
             .collect();
         Self::uniform(particles)
     }
@@ -244,4 +244,12 @@ where
     pub(crate) fn parts_mut(&mut self) -> (&mut Vec<OVector<T, D>>, &mut Vec<f64>) {
         (&mut self.particles, &mut self.log_weights)
     }
+}
+
+/// Index of the first non-finite element, if any.
+pub(crate) fn first_non_finite<T: RealField + Copy, D: Dim>(v: &OVector<T, D>) -> Option<usize>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    v.iter().position(|x| !x.is_finite())
 }

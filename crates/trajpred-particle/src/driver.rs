@@ -29,14 +29,14 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+use crate::alloc::ParticleAllocator;
 use crate::error::{ParticleError, Result};
 use crate::mkpf::Mkpf;
 use crate::pf::{ParticleFilter, ParticleFiltering};
 use nalgebra::allocator::Allocator;
-use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
+use nalgebra::{DefaultAllocator, Dim, OVector, RealField};
 use rand::Rng;
 use trajpred_core::Gaussian;
-use trajpred_kalman::FilterAllocator;
 use trajpred_kalman::driver::{TimeStepFilter, check_dt};
 use trajpred_kalman::{
     NoisyObservation, NoisyTransition, Observation, ObservationJacobian, Transition,
@@ -54,9 +54,7 @@ impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> WithTransition<Tr>
 where
     Tr: Transition<T, D> + Sync,
     Ob: Observation<T, D, M> + Sync + Clone,
-    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M>,
-    OVector<T, D>: Send + Sync,
-    OMatrix<T, D, D>: Send + Sync,
+    DefaultAllocator: ParticleAllocator<T, D, M>,
 {
     fn with_transition(&self, transition: Tr) -> Result<Self> {
         ParticleFilter::with_transition(self, transition)
@@ -67,11 +65,7 @@ impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> WithTransition<Tr> for Mkpf<T,
 where
     Tr: TransitionJacobian<T, D> + NoisyTransition<T, D> + Sync,
     Ob: ObservationJacobian<T, D, M> + NoisyObservation<T, D, M> + Sync + Clone,
-    DefaultAllocator: FilterAllocator<D, M>,
-    OVector<T, D>: Send + Sync,
-    OMatrix<T, D, D>: Send + Sync,
-    OVector<T, M>: Sync,
-    OMatrix<T, M, M>: Send + Sync,
+    DefaultAllocator: ParticleAllocator<T, D, M>,
 {
     fn with_transition(&self, transition: Tr) -> Result<Self> {
         Mkpf::with_transition(self, transition)

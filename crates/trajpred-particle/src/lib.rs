@@ -2,10 +2,10 @@
 #![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 
+mod alloc;
 pub mod cloud;
 pub mod driver;
 pub mod error;
-mod gauss;
 pub mod mkpf;
 pub mod pf;
 pub mod resample;
@@ -23,6 +23,7 @@ pub use trajpred_kalman::{
     ObservationJacobian, RangeBearing, Transition, TransitionJacobian,
 };
 
+pub use alloc::ParticleAllocator;
 pub use cloud::ParticleCloud;
 pub use error::{ParticleError, Result};
 pub use mkpf::{EkfStage, Mkpf, ParticlePrior, UkfVariant};

@@ -2,21 +2,21 @@
 //! carries a mean and a covariance and proposes from a UKF step followed by an EKF step, both the
 //! Kalman crate's own (`trajpred_kalman::Ukf`, `trajpred_kalman::Ekf`).
 
-use crate::cloud::ParticleCloud;
+use crate::alloc::ParticleAllocator;
+use crate::cloud::{ParticleCloud, first_non_finite};
 use crate::error::Result;
-use crate::gauss::{Density, first_non_finite, log_det_half, psd_factor, shifted, to_f64};
 use crate::pf::{
     MIN_PARTICLES_PER_TASK, ParticleFiltering, PfConfig, StepSummary, finish_step, log_likelihood,
     predict_clouds, propagate_one, step_noise, weigh_and_select,
 };
 use nalgebra::allocator::Allocator;
-use nalgebra::{Cholesky, DefaultAllocator, Dim, OMatrix, OVector, RealField};
+use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, RealField};
 use rand::Rng;
 use rayon::prelude::*;
 use std::marker::PhantomData;
 use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
-use trajpred_kalman::FilterAllocator;
+use trajpred_kalman::sampling::{ZeroMeanGaussian, covariance_sqrt, draw};
 use trajpred_kalman::{
     AugmentedUkf, Ekf, Filter, KalmanError, MerweSigmaPoints, NoisyObservation, NoisyTransition,
     Observation, ObservationJacobian, TransitionJacobian, Ukf,
@@ -210,8 +210,8 @@ where
     means: Vec<OVector<T, D>>,
     config: PfConfig,
     q_factor: OMatrix<T, D, D>,
-    transition_density: Density<T, D>,
-    likelihood: Density<T, M>,
+    transition_density: ZeroMeanGaussian<T, D>,
+    likelihood: ZeroMeanGaussian<T, M>,
     _m: PhantomData<fn() -> M>,
 }
 
@@ -232,11 +232,7 @@ impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> Mkpf<T, D, M, Tr, Ob>
 where
     Tr: TransitionJacobian<T, D> + NoisyTransition<T, D> + Sync,
     Ob: ObservationJacobian<T, D, M> + NoisyObservation<T, D, M> + Sync,
-    DefaultAllocator: FilterAllocator<D, M>,
-    OVector<T, D>: Send + Sync,
-    OMatrix<T, D, D>: Send + Sync,
-    OVector<T, M>: Sync,
-    OMatrix<T, M, M>: Send + Sync,
+    DefaultAllocator: ParticleAllocator<T, D, M>,
 {
     /// An MKPF over `cloud`, every particle starting with the covariance `initial_covariance`
     /// (the paper's `P_0^i = P_0`), with the sigma-point parameters `points` (the paper:
@@ -268,11 +264,11 @@ where
             }
             .into());
         }
-        psd_factor(&initial_covariance, "P")?;
+        covariance_sqrt(&initial_covariance, "P")?;
         points.weights(n)?;
-        let q_factor = psd_factor(transition.process_noise(), "Q")?;
-        let transition_density = Density::new(transition.process_noise(), "Q")?;
-        let likelihood = Density::new(observation.observation_noise(), "R")?;
+        let q_factor = covariance_sqrt(transition.process_noise(), "Q")?;
+        let transition_density = ZeroMeanGaussian::new(transition.process_noise(), "Q")?;
+        let likelihood = ZeroMeanGaussian::new(observation.observation_noise(), "R")?;
         let covariances = vec![initial_covariance; cloud.len()];
         let means = cloud.particles().to_vec();
         Ok(Mkpf {
@@ -525,18 +521,15 @@ where
         e: &[T],
     ) -> std::result::Result<Option<Moved<T, D>>, KalmanError> {
         let (_, q) = self.proposal(ukf, prior, z)?;
-        let Some(chol) = Cholesky::new(q.covariance.clone()) else {
+        let Ok(spread) = ZeroMeanGaussian::new(&q.covariance, "proposal covariance") else {
             return Ok(None);
         };
-        let l = chol.l();
-        let xn = shifted(&q.mean, &l, e);
+        let xn = draw(&q.mean, spread.factor(), e.iter().copied());
         if first_non_finite(&xn).is_some() {
             return Ok(None);
         }
         // ln q(x) with x - mean = L e: -(n ln 2 pi + ln det P + |e|^2) / 2
-        let e2: f64 = e.iter().map(|v| to_f64(*v) * to_f64(*v)).sum();
-        let n = e.len() as f64;
-        let log_q = -0.5 * (n * (2.0 * std::f64::consts::PI).ln() + e2) - log_det_half(&chol);
+        let log_q = spread.log_density_of_normals(e);
         let fx = self.transition.transition(x)?;
         let log_trans = self
             .transition_density
@@ -563,11 +556,7 @@ impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> ParticleFiltering<T, D, M>
 where
     Tr: TransitionJacobian<T, D> + NoisyTransition<T, D> + Sync,
     Ob: ObservationJacobian<T, D, M> + NoisyObservation<T, D, M> + Sync,
-    DefaultAllocator: FilterAllocator<D, M>,
-    OVector<T, D>: Send + Sync,
-    OMatrix<T, D, D>: Send + Sync,
-    OVector<T, M>: Sync,
-    OMatrix<T, M, M>: Send + Sync,
+    DefaultAllocator: ParticleAllocator<T, D, M>,
 {
     fn step<R: Rng + ?Sized>(
         &mut self,

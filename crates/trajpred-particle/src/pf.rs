@@ -2,9 +2,9 @@
 //! [`Mkpf`](crate::Mkpf) ([`ParticleFiltering`]), its configuration ([`PfConfig`]) and the
 //! per-step summary ([`StepSummary`]).
 
-use crate::cloud::ParticleCloud;
+use crate::alloc::ParticleAllocator;
+use crate::cloud::{ParticleCloud, first_non_finite};
 use crate::error::Result;
-use crate::gauss::{Density, first_non_finite, psd_factor, push_normals, shifted};
 use crate::resample::{Resampler, Resampling};
 use crate::weights::{ResamplePolicy, effective_sample_size_log, normalize_log_weights};
 use nalgebra::allocator::Allocator;
@@ -15,6 +15,7 @@ use std::marker::PhantomData;
 use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 use trajpred_kalman::driver::scan;
+use trajpred_kalman::sampling::{ZeroMeanGaussian, covariance_sqrt, draw, push_standard_normals};
 use trajpred_kalman::{Observation, Transition};
 
 /// Minimum particles per rayon task: below this the work per particle of the bootstrap
@@ -126,7 +127,7 @@ where
         check_observation(z, m)?;
     }
     let mut noise: Vec<T> = Vec::new();
-    push_normals(rng, cloud.len() * cloud.dim(), &mut noise);
+    push_standard_normals(rng, cloud.len() * cloud.dim(), &mut noise);
     Ok(noise)
 }
 
@@ -159,7 +160,7 @@ where
 /// `ln p(z | x) = ln N(residual(z, h(x)); 0, R)`.
 pub(crate) fn log_likelihood<T, D, M, Ob>(
     observation: &Ob,
-    density: &Density<T, M>,
+    density: &ZeroMeanGaussian<T, M>,
     x: &OVector<T, D>,
     z: &OVector<T, M>,
 ) -> Result<f64>
@@ -204,7 +205,7 @@ where
         }
         .into());
     }
-    let out = shifted(&fx, q_factor, e);
+    let out = draw(&fx, q_factor, e.iter().copied());
     if let Some(index) = first_non_finite(&out) {
         return Err(CoreError::NonFinite {
             what: "propagated particle",
@@ -237,7 +238,7 @@ where
     scan(0..steps, |prev: Option<&ParticleCloud<T, D>>, _| {
         let prev = prev.unwrap_or(cloud);
         noise.clear();
-        push_normals(rng, prev.len() * n, &mut noise);
+        push_standard_normals(rng, prev.len() * n, &mut noise);
         let particles: Vec<OVector<T, D>> = prev
             .particles()
             .par_iter()
@@ -348,7 +349,7 @@ where
     cloud: ParticleCloud<T, D>,
     config: PfConfig,
     q_factor: OMatrix<T, D, D>,
-    likelihood: Density<T, M>,
+    likelihood: ZeroMeanGaussian<T, M>,
     _m: PhantomData<fn() -> M>,
 }
 
@@ -356,9 +357,7 @@ impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> ParticleFilter<T, D, M, Tr, Ob
 where
     Tr: Transition<T, D> + Sync,
     Ob: Observation<T, D, M> + Sync,
-    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M>,
-    OVector<T, D>: Send + Sync,
-    OMatrix<T, D, D>: Send + Sync,
+    DefaultAllocator: ParticleAllocator<T, D, M>,
 {
     /// A filter over `cloud` with the transition (`f`, `Q` positive semi-definite) and the
     /// observation (`h`, `R` positive definite). Errors:
@@ -374,8 +373,8 @@ where
             }
             .into());
         }
-        let q_factor = psd_factor(transition.process_noise(), "Q")?;
-        let likelihood = Density::new(observation.observation_noise(), "R")?;
+        let q_factor = covariance_sqrt(transition.process_noise(), "Q")?;
+        let likelihood = ZeroMeanGaussian::new(observation.observation_noise(), "R")?;
         Ok(ParticleFilter {
             transition,
             observation,
@@ -437,11 +436,7 @@ impl<T: RealField + Copy, D: Dim, M: Dim, Tr, Ob> ParticleFiltering<T, D, M>
 where
     Tr: Transition<T, D> + Sync,
     Ob: Observation<T, D, M> + Sync,
-    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M>,
-    OVector<T, D>: Send + Sync,
-    OMatrix<T, D, D>: Send + Sync,
-    OVector<T, M>: Sync,
-    OMatrix<T, M, M>: Send + Sync,
+    DefaultAllocator: ParticleAllocator<T, D, M>,
 {
     fn step<R: Rng + ?Sized>(
         &mut self,

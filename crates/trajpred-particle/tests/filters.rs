@@ -577,3 +577,33 @@ fn rebuilding_the_mkpf_with_the_same_transition_keeps_its_proposal_means() {
         );
     }
 }
+
+/// The error convention across the Kalman and particle crates: a shared error the Kalman
+/// crate raises arrives as `ParticleError::Core`, its own variants as `ParticleError::Kalman`;
+/// into the core error a shared variant comes back as itself.
+#[test]
+fn kalman_errors_keep_the_shared_variants_in_core() {
+    let e: ParticleError = KalmanError::Core(CoreError::NotPositiveDefinite { what: "S" }).into();
+    assert!(
+        matches!(
+            e,
+            ParticleError::Core(CoreError::NotPositiveDefinite { what: "S" })
+        ),
+        "{e:?}"
+    );
+    let core: CoreError = e.into();
+    assert!(matches!(core, CoreError::NotPositiveDefinite { what: "S" }));
+    let e: ParticleError = KalmanError::Undefined { what: "bearing" }.into();
+    assert!(
+        matches!(
+            e,
+            ParticleError::Kalman(KalmanError::Undefined { what: "bearing" })
+        ),
+        "{e:?}"
+    );
+    let core: CoreError = e.into();
+    assert!(
+        matches!(&core, CoreError::Method { method, .. } if method == "trajpred-particle"),
+        "{core:?}"
+    );
+}

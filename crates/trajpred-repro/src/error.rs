@@ -3,6 +3,7 @@
 use crate::report::Difference;
 use std::fmt::Write as _;
 use std::path::PathBuf;
+use trajpred_core::CrateError;
 
 /// One difference a line.
 fn list(differences: &[Difference]) -> String {
@@ -14,26 +15,31 @@ fn list(differences: &[Difference]) -> String {
 }
 
 /// What can go wrong while reproducing a paper or checking a run.
+///
+/// An error any crate raises with one of the shared variants is [`ReproError::Core`]
+/// (converted from the crates' errors by `?`); the crates' own variants keep their crate's
+/// variant here.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum ReproError {
-    /// A method or data structure of the core crates refused its input.
+    /// A method or data structure refused its input (the variants every crate shares).
     #[error(transparent)]
     Core(#[from] trajpred_core::Error),
     /// A loader refused a data file.
     #[error(transparent)]
-    Data(#[from] trajpred_data::Error),
+    Data(trajpred_data::Error),
     /// A metric refused its input.
     #[error(transparent)]
-    Metrics(#[from] trajpred_metrics::MetricsError),
-    /// A filter refused its input.
+    Metrics(trajpred_metrics::MetricsError),
+    /// A filter failed.
     #[error(transparent)]
-    Kalman(#[from] trajpred_kalman::KalmanError),
-    /// A particle filter refused its input.
+    Kalman(trajpred_kalman::KalmanError),
+    /// A particle filter failed.
     #[error(transparent)]
-    Particle(#[from] trajpred_particle::ParticleError),
-    /// A neural model refused its input or failed to train.
+    Particle(trajpred_particle::ParticleError),
+    /// A neural model failed to train, save or load.
     #[error(transparent)]
-    Neural(#[from] trajpred_neural::NeuralError),
+    Neural(trajpred_neural::NeuralError),
     /// Reading or writing a file failed.
     #[error("{path}: {source}")]
     Io {
@@ -83,6 +89,27 @@ pub enum ReproError {
         differences: Vec<Difference>,
     },
 }
+
+/// `From` for the error of a crate that holds the shared variants in `Core`
+/// ([`CrateError`]): a shared variant becomes [`ReproError::Core`], the crate's own variants
+/// the crate's variant.
+macro_rules! from_crate_error {
+    ($($variant:ident($error:ty)),* $(,)?) => {$(
+        impl From<$error> for ReproError {
+            fn from(e: $error) -> Self {
+                e.split_core().map_or_else(ReproError::$variant, ReproError::Core)
+            }
+        }
+    )*};
+}
+
+from_crate_error!(
+    Data(trajpred_data::Error),
+    Metrics(trajpred_metrics::MetricsError),
+    Kalman(trajpred_kalman::KalmanError),
+    Particle(trajpred_particle::ParticleError),
+    Neural(trajpred_neural::NeuralError),
+);
 
 /// The reproduction's result type.
 pub type Result<T, E = ReproError> = std::result::Result<T, E>;

@@ -7,33 +7,31 @@ use thiserror::Error;
 /// Numerical trouble *inside* a path (collinear columns, a vanishing residual correlation)
 /// is not an error: the path stops or skips the column and says so in
 /// [`Lars::stop_reason`](crate::Lars::stop_reason) and [`Lars::excluded`](crate::Lars::excluded).
-#[derive(Debug, Clone, PartialEq, Error)]
+///
+/// The input errors every crate shares are [`trajpred_core::Error`]'s variants, wrapped in
+/// [`Error::Core`]: match them as `Error::Core(trajpred_core::Error::Empty { .. })`. The
+/// variants declared here are the sparse coders' own.
+#[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// An input that must hold at least one element was empty.
-    #[error("{what} is empty")]
-    Empty {
-        /// What was empty.
-        what: &'static str,
-    },
-    /// Two inputs whose sizes must agree do not.
-    #[error("dimension mismatch in {what}: expected {expected}, got {got}")]
-    DimensionMismatch {
-        /// Which inputs disagree.
-        what: &'static str,
-        /// The size that was required.
-        expected: usize,
-        /// The size that was given.
-        got: usize,
-    },
-    /// A value was NaN or infinite.
+    /// An input error shared with the other crates (see [`trajpred_core::Error`]): `Empty`
+    /// (no rows, no columns), `DimensionMismatch` (inputs whose sizes disagree), `NonFinite`
+    /// (a NaN or infinite value of a vector, or a sum or path value that overflowed: the
+    /// index is the row, knot or series), `InvalidParameter` (with the offending value) and
+    /// `TooShort` (a series too short for the windows and horizons). Its message is the core
+    /// error's.
+    #[error(transparent)]
+    Core(#[from] trajpred_core::Error),
+    /// A NaN or infinite entry of a matrix (the design, a series set, the coefficients, the
+    /// path's coefficients): the core `NonFinite` has a single index, this names the row and
+    /// the column.
     #[error("non-finite value in {what} at row {row}, column {col}")]
-    NonFinite {
-        /// Which input held the value.
+    NonFiniteEntry {
+        /// Which matrix held the value (for a set of series: row = point, column = series).
         what: &'static str,
-        /// Row of the first non-finite value (the index for a vector).
+        /// Row of the first non-finite value.
         row: usize,
-        /// Column of the first non-finite value (0 for a vector).
+        /// Its column.
         col: usize,
     },
     /// Every column of the design is constant (zero after centring, or exactly zero without an
@@ -50,25 +48,9 @@ pub enum Error {
         /// Column index.
         col: usize,
     },
-    /// A parameter outside its valid domain.
-    #[error("invalid parameter `{name}`: {reason}")]
-    InvalidParameter {
-        /// The parameter's name.
-        name: &'static str,
-        /// Why it is invalid.
-        reason: String,
-    },
-    /// A series is too short for the requested windows and horizons.
-    #[error("{what} too short: needs at least {needed}, got {got}")]
-    TooShort {
-        /// What is too short.
-        what: &'static str,
-        /// The minimum length.
-        needed: usize,
-        /// The length that was given.
-        got: usize,
-    },
 }
 
 /// `Result` with [`enum@Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+trajpred_core::crate_error!(Error, "trajpred-sparse");

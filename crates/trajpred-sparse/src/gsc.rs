@@ -8,6 +8,7 @@ use crate::lars::{Lars, LarsParams};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use trajpred_core::Error as CoreError;
 use trajpred_core::window::{HankelDesign, design_rows, hankel_design};
 
 /// Below this many design entries (rows x m x T) the horizons are fitted one after another:
@@ -53,8 +54,9 @@ impl GscParams {
     /// longest horizon). A constant series (every window column constant) gives `A = 0` and
     /// `b` = the mean target, instead of an error.
     ///
-    /// Errors: [`Error::InvalidParameter`] for `m = 0` or `T = 0`, [`Error::TooShort`],
-    /// [`Error::NonFinite`], and the errors of [`LarsParams::fit`].
+    /// Errors (the shared ones as [`Error::Core`]): [`CoreError::InvalidParameter`] for
+    /// `m = 0` or `T = 0`, [`CoreError::TooShort`], [`Error::NonFiniteEntry`] for a NaN or
+    /// infinite value, and the errors of [`LarsParams::fit`].
     pub fn fit(&self, series: &[f64]) -> Result<GroupSparseCoder> {
         self.fit_many(&[series])
     }
@@ -75,33 +77,36 @@ impl GscParams {
     /// ```
     ///
     /// Errors: as [`GscParams::fit`]; `TooShort` names the longest series when none is long
-    /// enough, `NonFinite` gives the series index as `col`.
+    /// enough, `NonFiniteEntry` gives the point as `row` and the series index as `col`.
     pub fn fit_many(&self, series: &[&[f64]]) -> Result<GroupSparseCoder> {
         let (m, horizons) = (self.window, self.horizons);
         if m == 0 {
-            return Err(Error::InvalidParameter {
+            return Err(CoreError::InvalidParameter {
                 name: "window",
-                reason: "window length m must be at least 1".into(),
-            });
+                reason: format!("window length m must be at least 1, got {m}"),
+            }
+            .into());
         }
         if horizons == 0 {
-            return Err(Error::InvalidParameter {
+            return Err(CoreError::InvalidParameter {
                 name: "horizons",
-                reason: "number of horizons T must be at least 1".into(),
-            });
+                reason: format!("number of horizons T must be at least 1, got {horizons}"),
+            }
+            .into());
         }
         let needed = m + horizons + 1;
         let longest = series.iter().map(|s| s.len()).max().unwrap_or(0);
         if longest < needed {
-            return Err(Error::TooShort {
+            return Err(CoreError::TooShort {
                 what: "series for group sparse coding",
                 needed,
                 got: longest,
-            });
+            }
+            .into());
         }
         for (col, s) in series.iter().enumerate() {
             if let Some(row) = s.iter().position(|v| !v.is_finite()) {
-                return Err(Error::NonFinite {
+                return Err(Error::NonFiniteEntry {
                     what: "series",
                     row,
                     col,
@@ -136,20 +141,15 @@ impl GscParams {
         let mut blocks = Vec::new();
         for s in series {
             if design_rows(s.len(), self.window, t).is_some() {
-                blocks.push(hankel_design(s, self.window, t).map_err(|e| {
-                    Error::InvalidParameter {
-                        name: "series",
-                        reason: e.to_string(),
-                    }
-                })?);
+                blocks.push(hankel_design(s, self.window, t)?);
             }
         }
         let d = if blocks.len() == 1 {
-            blocks.pop().ok_or(Error::TooShort {
+            blocks.pop().ok_or(Error::Core(CoreError::TooShort {
                 what: "series for group sparse coding",
                 needed: self.window + t,
                 got: 0,
-            })?
+            }))?
         } else {
             let rows: usize = blocks.iter().map(|b| b.target.len()).sum();
             let mut design = DMatrix::zeros(rows, self.window);
@@ -229,9 +229,11 @@ impl GroupSparseCoder {
     /// residual variances have length T. It predicts exactly as the coder they came from;
     /// it has no LARS paths ([`path`](Self::path) is `None`).
     ///
-    /// Errors: [`Error::InvalidParameter`] for m = 0 or T = 0, [`Error::DimensionMismatch`]
-    /// for inconsistent shapes, [`Error::NonFinite`] for a NaN or infinite value (and a
-    /// negative residual variance is an `InvalidParameter`).
+    /// Errors (the shared ones as [`Error::Core`]): [`CoreError::InvalidParameter`] for m = 0
+    /// or T = 0, [`CoreError::DimensionMismatch`] for inconsistent shapes,
+    /// [`Error::NonFiniteEntry`] for a NaN or infinite coefficient, [`CoreError::NonFinite`]
+    /// for one in the intercepts or residual variances (and a negative residual variance is
+    /// an `InvalidParameter`).
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
@@ -253,26 +255,28 @@ impl GroupSparseCoder {
     ) -> Result<Self> {
         let (horizons, m) = a.shape();
         if m == 0 || horizons == 0 {
-            return Err(Error::InvalidParameter {
+            return Err(CoreError::InvalidParameter {
                 name: "coefficients",
                 reason: format!("A must be at least 1 x 1, got {horizons} x {m}"),
-            });
+            }
+            .into());
         }
         for (what, len) in [
             ("intercepts vs rows of A", b.len()),
             ("residual variances vs rows of A", residual_variances.len()),
         ] {
             if len != horizons {
-                return Err(Error::DimensionMismatch {
+                return Err(CoreError::DimensionMismatch {
                     what,
                     expected: horizons,
                     got: len,
-                });
+                }
+                .into());
             }
         }
         if let Some(k) = a.iter().position(|v| !v.is_finite()) {
             // column-major storage: entry k is (k % T, k / T)
-            return Err(Error::NonFinite {
+            return Err(Error::NonFiniteEntry {
                 what: "coefficients",
                 row: k % horizons,
                 col: k / horizons,
@@ -283,14 +287,15 @@ impl GroupSparseCoder {
             ("residual variances", &residual_variances),
         ] {
             if let Some(row) = v.iter().position(|v| !v.is_finite()) {
-                return Err(Error::NonFinite { what, row, col: 0 });
+                return Err(CoreError::NonFinite { what, index: row }.into());
             }
         }
         if let Some(row) = residual_variances.iter().position(|v| *v < 0.0) {
-            return Err(Error::InvalidParameter {
+            return Err(CoreError::InvalidParameter {
                 name: "residual_variances",
                 reason: format!("entry {row} is negative: {}", residual_variances[row]),
-            });
+            }
+            .into());
         }
         Ok(GroupSparseCoder {
             params: GroupSparseCoder::params(m, horizons),
@@ -341,18 +346,19 @@ impl GroupSparseCoder {
     pub fn predict(&self, window: &[f64]) -> Result<Vec<f64>> {
         let m = self.window();
         if window.len() != m {
-            return Err(Error::DimensionMismatch {
+            return Err(CoreError::DimensionMismatch {
                 what: "window length vs m",
                 expected: m,
                 got: window.len(),
-            });
+            }
+            .into());
         }
         if let Some(row) = window.iter().position(|v| !v.is_finite()) {
-            return Err(Error::NonFinite {
+            return Err(CoreError::NonFinite {
                 what: "window",
-                row,
-                col: 0,
-            });
+                index: row,
+            }
+            .into());
         }
         Ok((0..self.horizons())
             .map(|t| {
@@ -372,11 +378,12 @@ impl GroupSparseCoder {
     pub fn predict_next(&self, history: &[f64]) -> Result<Vec<f64>> {
         let m = self.window();
         if history.len() < m {
-            return Err(Error::TooShort {
+            return Err(CoreError::TooShort {
                 what: "history",
                 needed: m,
                 got: history.len(),
-            });
+            }
+            .into());
         }
         self.predict(&history[history.len() - m..])
     }

@@ -6,6 +6,7 @@ use nalgebra::{DMatrix, DVector};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
+use trajpred_core::Error as CoreError;
 use trajpred_sparse::{Error, GroupSparseCoder, Lars};
 
 /// Eq. (20): x = 2 sin(0.1 t), y = sin(t) cos(0.1 t), z = 2 sin(t) cos(2 t), t_i = 0.01 pi i.
@@ -138,44 +139,54 @@ fn bad_input_is_typed() {
     let s: Vec<f64> = (0..10).map(f64::from).collect();
     assert!(matches!(
         GroupSparseCoder::params(0, 2).fit(&s),
-        Err(Error::InvalidParameter { name: "window", .. })
+        Err(Error::Core(CoreError::InvalidParameter {
+            name: "window",
+            ..
+        }))
     ));
     assert!(matches!(
         GroupSparseCoder::params(3, 0).fit(&s),
-        Err(Error::InvalidParameter {
+        Err(Error::Core(CoreError::InvalidParameter {
             name: "horizons",
             ..
-        })
+        }))
     ));
-    assert_eq!(
-        GroupSparseCoder::params(5, 5).fit(&s).unwrap_err(),
-        Error::TooShort {
+    assert!(matches!(
+        GroupSparseCoder::params(5, 5).fit(&s),
+        Err(Error::Core(CoreError::TooShort {
             what: "series for group sparse coding",
             needed: 11,
             got: 10
-        }
-    );
+        }))
+    ));
     let mut bad = s.clone();
     bad[4] = f64::NAN;
     assert!(matches!(
         GroupSparseCoder::params(2, 2).fit(&bad),
-        Err(Error::NonFinite { row: 4, .. })
+        Err(Error::NonFiniteEntry {
+            what: "series",
+            row: 4,
+            col: 0
+        })
     ));
     let gsc = GroupSparseCoder::params(2, 2).fit(&s).expect("fit");
     assert!(matches!(
         gsc.predict(&[1.0]),
-        Err(Error::DimensionMismatch {
+        Err(Error::Core(CoreError::DimensionMismatch {
             expected: 2,
             got: 1,
             ..
-        })
+        }))
     ));
     assert!(matches!(
         gsc.predict_next(&[1.0]),
-        Err(Error::TooShort { .. })
+        Err(Error::Core(CoreError::TooShort { .. }))
     ));
     assert!(matches!(
         gsc.predict(&[1.0, f64::INFINITY]),
-        Err(Error::NonFinite { .. })
+        Err(Error::Core(CoreError::NonFinite {
+            what: "window",
+            index: 1
+        }))
     ));
 }

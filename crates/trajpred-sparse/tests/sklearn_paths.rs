@@ -303,6 +303,7 @@ fn lars_path_returns_sklearns_values_in_sklearns_layout() {
 
 #[test]
 fn lars_path_rejects_a_bad_alpha_min() {
+    use trajpred_core::Error as CoreError;
     use trajpred_sparse::{Error, LarsPathOptions, lars_path};
     let f = fixture();
     let c = case(&f, "diabetes_lar");
@@ -317,10 +318,10 @@ fn lars_path_rejects_a_bad_alpha_min() {
         assert!(
             matches!(
                 r,
-                Err(Error::InvalidParameter {
+                Err(Error::Core(CoreError::InvalidParameter {
                     name: "alpha_min",
                     ..
-                })
+                }))
             ),
             "{bad}"
         );

@@ -136,7 +136,7 @@ impl Dataset {
 }
 
 fn data_error(e: trajpred_data::Error) -> Error {
-    Error::method("data", e)
+    Error::from_crate("data", e)
 }
 
 /// What [`load_tracks`] read.
@@ -266,7 +266,7 @@ impl Segmentation {
             return bad("max_gap", format!("must be finite and positive, got {g}"));
         }
         if self.min_points == 0 {
-            return bad("min_points", "must be at least 1".into());
+            return bad("min_points", "must be at least 1, got 0".into());
         }
         if let Some(dt) = self.resample
             && !(dt.is_finite() && dt > 0.0)
@@ -274,7 +274,7 @@ impl Segmentation {
             return bad("resample", format!("must be finite and positive, got {dt}"));
         }
         if self.max_resampled_points == 0 {
-            return bad("max_resampled_points", "must be at least 1".into());
+            return bad("max_resampled_points", "must be at least 1, got 0".into());
         }
         Ok(())
     }

@@ -46,28 +46,26 @@ impl EvalConfig {
     /// Checks the settings (every count at least 1, a finite positive threshold); the
     /// error names the first bad one. [`evaluate`] calls it before any forecast.
     pub fn validate(&self) -> Result<()> {
-        let bad = |name, reason: &str| {
-            Err(Error::InvalidParameter {
-                name,
-                reason: reason.into(),
-            })
-        };
+        let bad = |name, reason: &str| Err(Error::invalid_parameter(name, reason));
         if self.history == 0 {
-            return bad("history", "must be at least 1");
+            return bad("history", "must be at least 1, got 0");
         }
         if self.horizon == 0 {
-            return bad("horizon", "must be at least 1");
+            return bad("horizon", "must be at least 1, got 0");
         }
         if self.stride == 0 {
-            return bad("stride", "must be at least 1");
+            return bad("stride", "must be at least 1, got 0");
         }
         if !(self.threshold.is_finite() && self.threshold > 0.0) {
-            return bad("threshold", "must be finite and positive");
+            return bad(
+                "threshold",
+                &format!("must be finite and positive, got {}", self.threshold),
+            );
         }
         if self.max_origins_per_trajectory == Some(0) {
             return bad(
                 "max_origins_per_trajectory",
-                "must be at least 1 (None for every origin)",
+                "must be at least 1 (None for every origin), got 0",
             );
         }
         Ok(())

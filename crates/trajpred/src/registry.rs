@@ -181,7 +181,7 @@ pub fn leaderboard_methods() -> Vec<&'static str> {
 #[cfg(feature = "neural")]
 fn build_neural(name: &str, opts: &MethodOptions) -> Result<Option<Box<dyn Predictor>>> {
     use trajpred_neural::{KfuLstmNet, LstmNet, Mlp, RnnNet};
-    let e = |err: trajpred_neural::NeuralError| Error::method(name.to_string(), err);
+    let e = |err: trajpred_neural::NeuralError| Error::from_crate(name.to_string(), err);
     macro_rules! with_epochs {
         ($net:expr) => {{
             let mut net = $net.map_err(e)?;

@@ -4,6 +4,7 @@
 use crate::error::{KalmanError, Result};
 use nalgebra::allocator::Allocator;
 use nalgebra::{Const, DefaultAllocator, Dim, OMatrix, OVector, RealField};
+use trajpred_core::Error as CoreError;
 
 /// The lower Cholesky factor `L` (`A = L L^T`) of a symmetric positive definite matrix,
 /// computed in place by a plain Cholesky-Banachiewicz loop (faster than the general
@@ -24,35 +25,68 @@ where
     /// Factorises `a`, or `None` if a pivot is not strictly positive (or not finite).
     #[inline(always)]
     pub(crate) fn new(mut a: OMatrix<T, D, D>) -> Option<Self> {
-        let n = a.nrows();
         // one verdict without branches, as in `positive_definite_shifted`
         let big = T::max_value().unwrap_or(T::one() / T::zero());
         let mut ok = true;
-        for j in 0..n {
-            let mut d = a[(j, j)];
-            for k in 0..j {
-                d -= a[(j, k)] * a[(j, k)];
-            }
+        cholesky_in_place(&mut a, |d| {
             ok &= (d > T::zero()) & (d <= big);
-            let ljj = d.sqrt();
-            a[(j, j)] = ljj;
-            for i in (j + 1)..n {
-                let mut s = a[(i, j)];
-                for k in 0..j {
-                    s -= a[(i, k)] * a[(j, k)];
-                }
-                a[(i, j)] = s / ljj;
-            }
-            for i in 0..j {
-                a[(i, j)] = T::zero();
-            }
-        }
+            d.sqrt()
+        });
+        ok.then_some(Chol { l: a })
+    }
+
+    /// The factor `L` with `L L^T = a` of a symmetric positive **semi**-definite `a`: a
+    /// pivot up to `tol` (a zero eigen-direction, up to rounding) gives a zero column instead
+    /// of a failure; `None` if a pivot is below `-tol` (or not finite).
+    #[inline(always)]
+    pub(crate) fn semidefinite(mut a: OMatrix<T, D, D>, tol: T) -> Option<Self> {
+        let mut ok = true;
+        cholesky_in_place(&mut a, |d| {
+            ok &= (d >= -tol) & d.is_finite();
+            if d > tol { d.sqrt() } else { T::zero() }
+        });
         ok.then_some(Chol { l: a })
     }
 
     /// The factor `L`, by value.
     pub(crate) fn unpack(self) -> OMatrix<T, D, D> {
         self.l
+    }
+}
+
+/// The Cholesky-Banachiewicz loop in place on the lower triangle of `a` (the upper triangle
+/// set to zero): column `j`'s diagonal is `root(d_j)` of its pivot
+/// `d_j = a_jj - sum_(k<j) L_jk^2`, the entries below it are divided by that diagonal, or set
+/// to zero when it is zero (a zero column).
+#[inline(always)]
+fn cholesky_in_place<T, D>(a: &mut OMatrix<T, D, D>, mut root: impl FnMut(T) -> T)
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D>,
+{
+    let n = a.nrows();
+    for j in 0..n {
+        let mut d = a[(j, j)];
+        for k in 0..j {
+            d -= a[(j, k)] * a[(j, k)];
+        }
+        let ljj = root(d);
+        a[(j, j)] = ljj;
+        for i in (j + 1)..n {
+            if ljj == T::zero() {
+                a[(i, j)] = T::zero();
+                continue;
+            }
+            let mut s = a[(i, j)];
+            for k in 0..j {
+                s -= a[(i, k)] * a[(j, k)];
+            }
+            a[(i, j)] = s / ljj;
+        }
+        for i in 0..j {
+            a[(i, j)] = T::zero();
+        }
     }
 }
 
@@ -201,7 +235,7 @@ where
 }
 
 /// The `L D L^T` factorisation of a symmetric positive definite matrix, or
-/// [`KalmanError::NotPositiveDefinite`] naming `what`.
+/// [`trajpred_core::Error::NotPositiveDefinite`] naming `what`.
 #[inline(always)]
 pub(crate) fn ldl<T, D>(m: OMatrix<T, D, D>, what: &'static str) -> Result<Ldl<T, D>>
 where
@@ -211,12 +245,12 @@ where
 {
     match Ldl::factor(m, T::zero()) {
         (f, true) => Ok(f),
-        _ => Err(KalmanError::NotPositiveDefinite { what }),
+        _ => Err(CoreError::NotPositiveDefinite { what }.into()),
     }
 }
 
 /// Cholesky factor of a symmetric positive definite matrix, or
-/// [`KalmanError::NotPositiveDefinite`] naming `what`.
+/// [`trajpred_core::Error::NotPositiveDefinite`] naming `what`.
 #[inline(always)]
 pub(crate) fn cholesky<T, D>(m: OMatrix<T, D, D>, what: &'static str) -> Result<Chol<T, D>>
 where
@@ -224,5 +258,5 @@ where
     D: Dim,
     DefaultAllocator: Allocator<D, D>,
 {
-    Chol::new(m).ok_or(KalmanError::NotPositiveDefinite { what })
+    Chol::new(m).ok_or(KalmanError::Core(CoreError::NotPositiveDefinite { what }))
 }

@@ -293,9 +293,9 @@ where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     /// `F` and `Q`: both square of the same size, finite, `Q` symmetric positive
-    /// semi-definite. Errors: [`DimensionMismatch`](crate::KalmanError::DimensionMismatch),
-    /// [`NonFinite`](crate::KalmanError::NonFinite),
-    /// [`NotPositiveDefinite`](crate::KalmanError::NotPositiveDefinite) (`"Q"`).
+    /// semi-definite. Errors: [`DimensionMismatch`](trajpred_core::Error::DimensionMismatch),
+    /// [`NonFinite`](trajpred_core::Error::NonFinite),
+    /// [`NotPositiveDefinite`](trajpred_core::Error::NotPositiveDefinite) (`"Q"`).
     pub fn new(f: OMatrix<T, D, D>, q: OMatrix<T, D, D>) -> Result<Self> {
         let n = f.nrows();
         check_square(&f, n, "F")?;
@@ -437,9 +437,9 @@ where
         Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M> + Allocator<M, D>,
 {
     /// `H` (`m x n`) and `R` (`m x m`, symmetric positive definite). Errors:
-    /// [`DimensionMismatch`](crate::KalmanError::DimensionMismatch),
-    /// [`NonFinite`](crate::KalmanError::NonFinite),
-    /// [`NotPositiveDefinite`](crate::KalmanError::NotPositiveDefinite) (`"R"`).
+    /// [`DimensionMismatch`](trajpred_core::Error::DimensionMismatch),
+    /// [`NonFinite`](trajpred_core::Error::NonFinite),
+    /// [`NotPositiveDefinite`](trajpred_core::Error::NotPositiveDefinite) (`"R"`).
     pub fn new(h: OMatrix<T, M, D>, r: OMatrix<T, M, M>) -> Result<Self> {
         check_square(&r, h.nrows(), "R vs H")?;
         check_finite(&h, "H")?;

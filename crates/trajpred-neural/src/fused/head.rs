@@ -15,7 +15,7 @@
 use super::bridge;
 use super::{Mat, Real, activate, activate_backward, add_column_sums, gemm};
 use crate::config::Activation;
-use crate::error::{NeuralError, Result};
+use crate::error::{CoreError, NeuralError, Result};
 use burn::backend::flex::FlexTensor;
 use burn::tensor::Tensor;
 
@@ -77,11 +77,11 @@ pub(crate) struct Cache<T> {
 }
 
 fn mismatch(what: &'static str, expected: usize, got: usize) -> NeuralError {
-    NeuralError::DimensionMismatch {
+    NeuralError::Core(CoreError::DimensionMismatch {
         what,
         expected,
         got,
-    }
+    })
 }
 
 /// The forward pass: `h` `[B, input]`, the packed `params`, the targets `y` `[B, output]`;

@@ -16,7 +16,7 @@ use super::{
     Mat, Real, activate, activate_backward, add_column_sums, cell_backward, cell_forward, gemm,
 };
 use crate::config::Activation;
-use crate::error::{NeuralError, Result};
+use crate::error::{CoreError, NeuralError, Result};
 use burn::backend::flex::FlexTensor;
 use burn::tensor::Tensor;
 
@@ -147,10 +147,12 @@ pub(crate) fn forward<T: Real>(
 ) -> Result<(Vec<T>, Cache<T>)> {
     let d = spec.d;
     let off = spec.offsets();
-    let mismatch = |what, expected, got| NeuralError::DimensionMismatch {
-        what,
-        expected,
-        got,
+    let mismatch = |what, expected, got| {
+        NeuralError::Core(CoreError::DimensionMismatch {
+            what,
+            expected,
+            got,
+        })
     };
     if params.len() != off.total {
         return Err(mismatch("fused KFU parameters", off.total, params.len()));
@@ -338,11 +340,11 @@ pub(crate) fn backward<T: Real>(
         batch, c, steps, ..
     } = *cache;
     if g.len() != batch * steps * 2 * d || params.len() != off.total {
-        return Err(NeuralError::DimensionMismatch {
+        return Err(NeuralError::Core(CoreError::DimensionMismatch {
             what: "fused KFU output gradient",
             expected: batch * steps * 2 * d,
             got: g.len(),
-        });
+        }));
     }
     let updates = c - 1;
     let rows = steps * batch;
@@ -572,11 +574,11 @@ pub(crate) fn sequence(
 ) -> Result<Tensor<3>> {
     let [batch, c, d] = z.dims();
     if d != spec.d {
-        return Err(NeuralError::DimensionMismatch {
+        return Err(NeuralError::Core(CoreError::DimensionMismatch {
             what: "fused KFU axes",
             expected: spec.d,
             got: d,
-        });
+        }));
     }
     let prims = vec![
         bridge::prim(z, "KFU observations")?,

@@ -8,7 +8,7 @@
 
 use super::bridge;
 use super::{Mat, Real, add_column_sums, cell_backward, cell_forward, gemm, gemm_by_transpose};
-use crate::error::{NeuralError, Result};
+use crate::error::{CoreError, NeuralError, Result};
 use burn::backend::flex::FlexTensor;
 use burn::tensor::Tensor;
 
@@ -60,11 +60,11 @@ fn check_len<T>(v: &[T], n: usize, what: &'static str) -> Result<()> {
     if v.len() == n {
         Ok(())
     } else {
-        Err(NeuralError::DimensionMismatch {
+        Err(NeuralError::Core(CoreError::DimensionMismatch {
             what,
             expected: n,
             got: v.len(),
-        })
+        }))
     }
 }
 
@@ -365,11 +365,11 @@ fn run<const D: usize>(
         hidden: g4 / 4,
     };
     if last && steps == 0 {
-        return Err(NeuralError::DimensionMismatch {
+        return Err(NeuralError::Core(CoreError::DimensionMismatch {
             what: "fused LSTM steps",
             expected: 1,
             got: 0,
-        });
+        }));
     }
     let prims = vec![
         bridge::prim(x, "LSTM input")?,

@@ -4,6 +4,7 @@ use super::{Exclusion, LarsParams, PathEvent, StopReason};
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
+use trajpred_core::Error as CoreError;
 
 /// A fitted LARS path: every knot, the events that changed the active set, and the final
 /// model on the original scale.
@@ -126,24 +127,26 @@ impl Lars {
     /// Prediction of the model at knot `knot` for one sample.
     pub fn predict_row_at(&self, knot: usize, row: &[f64]) -> Result<f64> {
         if knot >= self.alphas.len() {
-            return Err(Error::InvalidParameter {
+            return Err(CoreError::InvalidParameter {
                 name: "knot",
                 reason: format!("path has {} knots, got {knot}", self.alphas.len()),
-            });
+            }
+            .into());
         }
         if row.len() != self.n_features {
-            return Err(Error::DimensionMismatch {
+            return Err(CoreError::DimensionMismatch {
                 what: "sample length vs features",
                 expected: self.n_features,
                 got: row.len(),
-            });
+            }
+            .into());
         }
         if let Some(i) = row.iter().position(|v| !v.is_finite()) {
-            return Err(Error::NonFinite {
+            return Err(CoreError::NonFinite {
                 what: "sample",
-                row: i,
-                col: 0,
-            });
+                index: i,
+            }
+            .into());
         }
         let b = self.coef_path().row(knot);
         Ok(self.intercepts[knot] + b.iter().zip(row).map(|(b, x)| b * x).sum::<f64>())
@@ -152,15 +155,16 @@ impl Lars {
     /// Predictions of the final model for every row of `x` (n x p), original scale.
     pub fn predict(&self, x: &DMatrix<f64>) -> Result<DVector<f64>> {
         if x.ncols() != self.n_features {
-            return Err(Error::DimensionMismatch {
+            return Err(CoreError::DimensionMismatch {
                 what: "design columns vs features",
                 expected: self.n_features,
                 got: x.ncols(),
-            });
+            }
+            .into());
         }
         for j in 0..x.ncols() {
             if let Some(row) = x.column(j).iter().position(|v| !v.is_finite()) {
-                return Err(Error::NonFinite {
+                return Err(Error::NonFiniteEntry {
                     what: "design",
                     row,
                     col: j,

@@ -18,6 +18,7 @@ use crate::kernels::dot;
 use nalgebra::DMatrix;
 use path::Core;
 use serde::{Deserialize, Serialize};
+use trajpred_core::Error as CoreError;
 
 /// Which path to compute.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -115,13 +116,17 @@ pub enum StopReason {
 /// ```
 /// use nalgebra::DMatrix;
 /// use trajpred_sparse::{Lars, Method, Error};
+/// use trajpred_core::Error as CoreError;
 /// let x = DMatrix::from_row_slice(4, 2, &[1.0, 0.0, 2.0, 1.0, 3.0, 0.0, 4.0, 2.0]);
 /// let y = [1.0, 3.0, 3.0, 6.0];
 /// let fit = Lars::params().method(Method::Lasso).fit(&x, &y)?;
 /// // the full path ends at least squares: y = 0 + 1 * x1 + 1 * x2 fits exactly
 /// assert!((fit.predict_row(&[5.0, 1.0])? - 6.0).abs() < 1e-9);
 /// // bad parameters are typed errors
-/// assert!(matches!(Lars::params().alpha_min(-1.0).fit(&x, &y), Err(Error::InvalidParameter { .. })));
+/// assert!(matches!(
+///     Lars::params().alpha_min(-1.0).fit(&x, &y),
+///     Err(Error::Core(CoreError::InvalidParameter { name: "alpha_min", .. }))
+/// ));
 /// # Ok::<(), Error>(())
 /// ```
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -186,10 +191,11 @@ impl LarsParams {
 
     fn validate(&self) -> Result<()> {
         if !(self.alpha_min.is_finite() && self.alpha_min >= 0.0) {
-            return Err(Error::InvalidParameter {
+            return Err(CoreError::InvalidParameter {
                 name: "alpha_min",
                 reason: format!("must be finite and non-negative, got {}", self.alpha_min),
-            });
+            }
+            .into());
         }
         let checks: [(&'static str, f64, f64); 3] = [
             ("tie_tolerance", self.tie_tolerance, 1e-3),
@@ -198,10 +204,11 @@ impl LarsParams {
         ];
         for (name, v, max) in checks {
             if !(v.is_finite() && (0.0..=max).contains(&v)) {
-                return Err(Error::InvalidParameter {
+                return Err(CoreError::InvalidParameter {
                     name,
                     reason: format!("must lie in [0, {max}], got {v}"),
-                });
+                }
+                .into());
             }
         }
         Ok(())
@@ -209,33 +216,38 @@ impl LarsParams {
 
     /// Computes the path for design `x` (n x p, one row per sample) and target `y` (length n).
     ///
-    /// Errors: [`Error::Empty`] for no rows or no columns, [`Error::DimensionMismatch`] if
-    /// `y.len() != n`, [`Error::NonFinite`] for NaN or infinite input, for a target whose sum
-    /// or (centred) squared norm overflows `f64` (`row` is where the running sum overflows;
-    /// values beyond about 1e154 in magnitude), and for a path whose alphas, coefficients or
-    /// intercepts overflow; [`Error::Overflow`] for a design column whose squared norm, mean
-    /// or centred norm overflows;
-    /// [`Error::AllColumnsConstant`] when no column can enter, [`Error::InvalidParameter`]
-    /// for a bad setting.
+    /// Errors (the shared ones as [`Error::Core`]): [`CoreError::Empty`] for no rows or no
+    /// columns, [`CoreError::DimensionMismatch`] if `y.len() != n`,
+    /// [`Error::NonFiniteEntry`] for a NaN or infinite design entry (and for path
+    /// coefficients that overflow: row = knot, column = feature), [`CoreError::NonFinite`] for
+    /// a NaN or infinite target value, for a target whose sum or (centred) squared norm
+    /// overflows `f64` (`index` is where the running sum overflows; values beyond about 1e154
+    /// in magnitude), and for path alphas or intercepts that overflow (`index` is the knot);
+    /// [`Error::Overflow`] for a design column whose squared norm, mean or centred norm
+    /// overflows; [`Error::AllColumnsConstant`] when no column can enter,
+    /// [`CoreError::InvalidParameter`] for a bad setting.
     pub fn fit(&self, x: &DMatrix<f64>, y: &[f64]) -> Result<Lars> {
         self.validate()?;
         let (n, p) = x.shape();
         if n == 0 {
-            return Err(Error::Empty {
+            return Err(CoreError::Empty {
                 what: "design rows",
-            });
+            }
+            .into());
         }
         if p == 0 {
-            return Err(Error::Empty {
+            return Err(CoreError::Empty {
                 what: "design columns",
-            });
+            }
+            .into());
         }
         if y.len() != n {
-            return Err(Error::DimensionMismatch {
+            return Err(CoreError::DimensionMismatch {
                 what: "target length vs design rows",
                 expected: n,
                 got: y.len(),
-            });
+            }
+            .into());
         }
         // one pass per column: a NaN or infinity makes the squared norm non-finite, and only
         // then is the offending entry located
@@ -245,7 +257,7 @@ impl LarsParams {
             let sq = dot(col.as_slice(), col.as_slice());
             if !sq.is_finite() {
                 if let Some(row) = col.iter().position(|v| !v.is_finite()) {
-                    return Err(Error::NonFinite {
+                    return Err(Error::NonFiniteEntry {
                         what: "design",
                         row,
                         col: j,
@@ -256,11 +268,11 @@ impl LarsParams {
             raw_norms.push(sq.sqrt());
         }
         if let Some(row) = y.iter().position(|v| !v.is_finite()) {
-            return Err(Error::NonFinite {
+            return Err(CoreError::NonFinite {
                 what: "target",
-                row,
-                col: 0,
-            });
+                index: row,
+            }
+            .into());
         }
 
         // --- standardise ------------------------------------------------------------------
@@ -314,20 +326,20 @@ impl LarsParams {
             0.0
         };
         if !y_mean.is_finite() {
-            return Err(Error::NonFinite {
+            return Err(CoreError::NonFinite {
                 what: "target sum (it overflows f64: rescale y)",
-                row: first_overflow(y.iter().copied()),
-                col: 0,
-            });
+                index: first_overflow(y.iter().copied()),
+            }
+            .into());
         }
         let ys: Vec<f64> = y.iter().map(|v| v - y_mean).collect();
         // every correlation is bounded by |x_j| |y|: a finite squared norm keeps them finite
         if !dot(&ys, &ys).is_finite() {
-            return Err(Error::NonFinite {
+            return Err(CoreError::NonFinite {
                 what: "centred target's squared norm (it overflows f64: rescale y)",
-                row: first_overflow(ys.iter().map(|v| v * v)),
-                col: 0,
-            });
+                index: first_overflow(ys.iter().map(|v| v * v)),
+            }
+            .into());
         }
 
         let use_gram = match self.gram {
@@ -382,14 +394,14 @@ impl LarsParams {
                 .map(|i| (i % knots, i / knots))
         };
         if let Some(k) = path.alphas.iter().position(|a| !a.is_finite()) {
-            return Err(Error::NonFinite {
+            return Err(CoreError::NonFinite {
                 what: "path alphas (an intermediate value overflowed: rescale X or y)",
-                row: k,
-                col: 0,
-            });
+                index: k,
+            }
+            .into());
         }
         if let Some((k, j)) = bad_coef(&std_path).or_else(|| bad_coef(orig)) {
-            return Err(Error::NonFinite {
+            return Err(Error::NonFiniteEntry {
                 what: "path coefficients (knot, feature; an intermediate value overflowed: \
                        rescale X or y)",
                 row: k,
@@ -397,11 +409,11 @@ impl LarsParams {
             });
         }
         if let Some(k) = intercepts.iter().position(|v| !v.is_finite()) {
-            return Err(Error::NonFinite {
+            return Err(CoreError::NonFinite {
                 what: "path intercepts (an intermediate value overflowed: rescale X or y)",
-                row: k,
-                col: 0,
-            });
+                index: k,
+            }
+            .into());
         }
         Ok(Lars {
             params: self.clone(),

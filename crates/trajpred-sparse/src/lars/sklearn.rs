@@ -91,7 +91,7 @@ pub struct LarsPath {
 /// `rank(X)` steps) where scikit-learn goes on until `max_iter`.
 ///
 /// Errors: those of [`LarsParams::fit`](super::LarsParams::fit); an invalid `alpha_min` is
-/// [`Error::InvalidParameter`](crate::Error::InvalidParameter).
+/// [`trajpred_core::Error::InvalidParameter`].
 ///
 /// ```
 /// use nalgebra::DMatrix;

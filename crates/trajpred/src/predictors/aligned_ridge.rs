@@ -60,10 +60,10 @@ impl Default for AlignedRidgeParams {
 impl AlignedRidgeParams {
     fn validate(&self) -> Result<()> {
         if self.lags == 0 {
-            return Err(invalid("lags", "must be at least 1"));
+            return Err(invalid("lags", "must be at least 1, got 0"));
         }
         if self.horizons == 0 {
-            return Err(invalid("horizons", "must be at least 1"));
+            return Err(invalid("horizons", "must be at least 1, got 0"));
         }
         let ok = |l: &f64| l.is_finite() && *l >= 0.0;
         if let Some(l) = self.lambda
@@ -79,7 +79,10 @@ impl AlignedRidgeParams {
         {
             return Err(invalid(
                 "lambda_grid",
-                "needs at least one finite, non-negative strength",
+                format!(
+                    "needs at least one strength, each finite and non-negative, got {:?}",
+                    self.lambda_grid
+                ),
             ));
         }
         if self.folds < 2 {
@@ -445,7 +448,12 @@ impl Predictor for AlignedRidge {
                         Some((_, b)) if b <= e => acc,
                         _ => Some((l, e)),
                     })
-                    .ok_or_else(|| invalid("lambda_grid", "no strength could be scored"))?;
+                    .ok_or_else(|| {
+                        invalid(
+                            "lambda_grid",
+                            format!("no strength could be scored, got scores {scores:?}"),
+                        )
+                    })?;
                 (best.0, scores)
             }
         };

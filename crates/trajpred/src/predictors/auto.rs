@@ -172,7 +172,7 @@ impl Auto {
     /// 2 folds or bad evaluation settings.
     pub fn new(params: AutoParams, options: MethodOptions) -> Result<Self> {
         if params.candidates.is_empty() {
-            return Err(invalid("candidates", "needs at least one method"));
+            return Err(invalid("candidates", "needs at least one method, got none"));
         }
         if params.folds < 2 {
             return Err(invalid(
@@ -183,7 +183,13 @@ impl Auto {
         params.eval.validate()?;
         for c in &params.candidates {
             if c == "auto" {
-                return Err(invalid("candidates", "`auto` cannot choose among itself"));
+                return Err(invalid(
+                    "candidates",
+                    format!(
+                        "`auto` cannot choose among itself, got {:?}",
+                        params.candidates
+                    ),
+                ));
             }
             registry::build(c, &options)?;
         }

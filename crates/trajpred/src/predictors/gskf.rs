@@ -50,10 +50,10 @@ impl Default for GskfParams {
 impl GskfParams {
     fn validate(&self) -> Result<()> {
         if self.window == 0 {
-            return Err(invalid("window", "m must be at least 1"));
+            return Err(invalid("window", "m must be at least 1, got 0"));
         }
         if self.horizons == 0 {
-            return Err(invalid("horizons", "T must be at least 1"));
+            return Err(invalid("horizons", "T must be at least 1, got 0"));
         }
         if let Some(q) = self.q
             && !(q.is_finite() && q >= 0.0)
@@ -68,7 +68,10 @@ impl GskfParams {
         {
             return Err(invalid(
                 "q_grid",
-                "needs at least one finite, non-negative multiplier",
+                format!(
+                    "needs at least one multiplier, each finite and non-negative, got {:?}",
+                    self.q_grid
+                ),
             ));
         }
         Ok(())
@@ -76,11 +79,11 @@ impl GskfParams {
 }
 
 fn sparse_error(e: trajpred_sparse::Error) -> Error {
-    Error::method("gsc", e)
+    Error::from_crate("gsc", e)
 }
 
 fn kalman_error(e: trajpred_kalman::KalmanError) -> Error {
-    Error::method("gskf", e)
+    Error::from_crate("gskf", e)
 }
 
 /// The training series of axis `a`: one per trajectory long enough for the GSC designs.
@@ -165,7 +168,7 @@ impl AxisFilter {
                 mean: DVector::zeros(t),
                 covariance: p_prior.clone(),
             };
-            let innov = Innovation::new(DVector::zeros(t), s.clone()).map_err(kalman_error)?;
+            let innov = Innovation::new(DVector::zeros(t), s.clone())?;
             let next = ikf
                 .correct(&prior, &innov)
                 .map_err(kalman_error)?
@@ -198,7 +201,7 @@ impl AxisFilter {
             covariance: self.p_prior.clone(),
         };
         let v = residuals(&self.gsc, x, i)?;
-        let innov = Innovation::new(v, self.s.clone()).map_err(kalman_error)?;
+        let innov = Innovation::new(v, self.s.clone())?;
         self.ikf.correct(&prior, &innov).map_err(kalman_error)
     }
 }

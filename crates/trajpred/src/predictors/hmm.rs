@@ -151,21 +151,24 @@ impl Hmm {
     /// A validated, unfitted predictor.
     pub fn new(params: HmmParams) -> Result<Self> {
         if params.states == Some(0) {
-            return Err(invalid("states", "K must be at least 1"));
+            return Err(invalid("states", "K must be at least 1, got 0"));
         }
         if params.states.is_none()
             && (params.candidates.is_empty() || params.candidates.contains(&0))
         {
             return Err(invalid(
                 "candidates",
-                "need at least one K, each at least 1",
+                format!(
+                    "need at least one K, each at least 1, got {:?}",
+                    params.candidates
+                ),
             ));
         }
         if params.max_iterations == 0 {
-            return Err(invalid("max_iterations", "must be at least 1"));
+            return Err(invalid("max_iterations", "must be at least 1, got 0"));
         }
         if params.filter_window == 0 {
-            return Err(invalid("filter_window", "must be at least 1"));
+            return Err(invalid("filter_window", "must be at least 1, got 0"));
         }
         Ok(Hmm {
             params,

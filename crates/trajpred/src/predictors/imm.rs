@@ -89,7 +89,10 @@ impl ImmParams {
         if self.fit_tracks < 4 || self.fit_points < 3 {
             return Err(invalid(
                 "fit_tracks",
-                "the fit needs at least 4 tracks of at least 3 points",
+                format!(
+                    "the fit needs at least 4 tracks of at least 3 points, got {} tracks of {} points",
+                    self.fit_tracks, self.fit_points
+                ),
             ));
         }
         Ok(())
@@ -119,7 +122,7 @@ pub struct ImmPredictor {
 type Mode = Box<dyn Filter<f64, U5, U2>>;
 
 fn kalman(e: KalmanError) -> Error {
-    Error::method("imm", e)
+    Error::from_crate("imm", e)
 }
 
 /// The IMM for a step of `dt` seconds under `p`.

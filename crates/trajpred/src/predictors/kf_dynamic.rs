@@ -145,7 +145,7 @@ impl KfDynamicParams {
 }
 
 fn kalman_error(method: &str) -> impl Fn(trajpred_kalman::KalmanError) -> Error + '_ {
-    move |e| Error::method(method, e)
+    move |e| Error::from_crate(method, e)
 }
 
 /// Which of the two predictors runs.

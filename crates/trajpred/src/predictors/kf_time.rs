@@ -83,7 +83,10 @@ impl KfTimeParams {
         if self.fit_tracks == 0 || self.fit_points < 3 {
             return Err(invalid(
                 "fit_tracks",
-                "the fit needs at least one track of at least 3 points",
+                format!(
+                    "the fit needs at least one track of at least 3 points, got {} tracks of {} points",
+                    self.fit_tracks, self.fit_points
+                ),
             ));
         }
         Ok(())
@@ -130,7 +133,7 @@ macro_rules! sized {
 }
 
 fn kalman(e: KalmanError) -> Error {
-    Error::method("kf-time", e)
+    Error::from_crate("kf-time", e)
 }
 
 impl KfTime {
@@ -294,13 +297,13 @@ impl Predictor for KfTime {
             (-2.0, 3.0),
         );
         if !ll.is_finite() {
-            return Err(Error::method(
-                self.name().to_string(),
-                KalmanError::InvalidParameter {
-                    name: "noise",
-                    reason: "no noise setting gives a finite likelihood on the training tracks"
-                        .into(),
-                },
+            return Err(Error::invalid_parameter(
+                "noise",
+                format!(
+                    "no spectral density in [1e-4, 1e3] and observation variance in [1e-2, 1e3] \
+                     gives {} a finite likelihood on the training tracks (best: {ll})",
+                    self.name()
+                ),
             ));
         }
         self.params.spectral_density = q;

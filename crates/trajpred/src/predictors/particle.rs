@@ -78,7 +78,7 @@ impl ParticlePredictor {
     /// A validated predictor.
     pub fn new(params: ParticleParams) -> Result<Self> {
         if params.particles == 0 {
-            return Err(invalid("particles", "need at least one particle"));
+            return Err(invalid("particles", "need at least one particle, got 0"));
         }
         for (name, v) in [
             ("accel_density", params.accel_density),
@@ -142,8 +142,8 @@ impl Predictor for ParticlePredictor {
     fn forecast_times(&self, history: &Trajectory, times: &[f64]) -> Result<Forecast> {
         check_forecast_args(history, times.len(), self.min_history())?;
         let method = self.method();
-        let kalman = |e: trajpred_kalman::KalmanError| Error::method(method, e);
-        let particle = |e: trajpred_particle::ParticleError| Error::method(method, e);
+        let kalman = |e: trajpred_kalman::KalmanError| Error::from_crate(method, e);
+        let particle = |e: trajpred_particle::ParticleError| Error::from_crate(method, e);
         let p = &self.params;
         let d = history.dim();
         let n = 2 * d;

@@ -12,7 +12,7 @@ pub use super::models::{choose_noise, ct_model, cv_model, kept_frames};
 use crate::spec::MethodSpec;
 use crate::{ReproError, Result};
 use nalgebra::allocator::Allocator;
-use nalgebra::{DefaultAllocator, DimName, OMatrix, OVector, U2, U4, U5};
+use nalgebra::{DefaultAllocator, DimName, OMatrix, U2, U4, U5};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::Deserialize;
@@ -22,7 +22,7 @@ use trajpred_kalman::{
     Ekf, LinearObservation, MerweSigmaPoints, NoisyTransition, TransitionJacobian, Ukf,
 };
 use trajpred_particle::driver::TimedParticles;
-use trajpred_particle::{Mkpf, ParticleFilter, ParticlePrior};
+use trajpred_particle::{Mkpf, ParticleAllocator, ParticleFilter, ParticlePrior};
 
 /// The motion model of the filters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -262,9 +262,7 @@ fn run_generic<D, Tr>(
 where
     D: DimName,
     Tr: TransitionJacobian<f64, D> + NoisyTransition<f64, D> + Sync,
-    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<U2, D> + Allocator<D, U2>,
-    OVector<f64, D>: Send + Sync,
-    OMatrix<f64, D, D>: Send + Sync,
+    DefaultAllocator: ParticleAllocator<f64, D, U2>,
     OMatrix<f64, U2, D>: Send + Sync,
 {
     let obs = observation::<D>(setup.position_sd)?;
