@@ -13,11 +13,13 @@
 //! `tests/examples_run.rs` runs it over several seeds.
 #![allow(clippy::print_stdout)]
 
-use nalgebra::{Matrix2, Matrix5, Vector2, Vector5};
-use rand::SeedableRng;
+// everything but the noise generator comes through trajpred-kalman's re-exports
 use rand_distr::{Distribution, StandardNormal};
-use trajpred_core::Gaussian;
-use trajpred_kalman::{CoordinatedTurn, Filter, MerweSigmaPoints, RangeBearing, Transition, Ukf};
+use trajpred_kalman::nalgebra::{Matrix2, Matrix5, Vector2, Vector5};
+use trajpred_kalman::rand::SeedableRng;
+use trajpred_kalman::{
+    CoordinatedTurn, Filter, Gaussian, MerweSigmaPoints, RangeBearing, Transition, Ukf,
+};
 
 /// What one run measured.
 #[derive(Debug, Clone, Copy)]

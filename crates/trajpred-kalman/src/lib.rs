@@ -13,6 +13,9 @@ pub mod model;
 /// The linear algebra the filters take and return, re-exported so that a user needs no
 /// separate (and exactly matching) nalgebra dependency.
 pub use nalgebra;
+/// The random number traits [`sampling`] takes (an injected, seeded generator), re-exported so
+/// that a user's generator matches them.
+pub use rand;
 /// The Gaussian state every filter steps.
 pub use trajpred_core::Gaussian;
 
