@@ -28,7 +28,7 @@ where
         // one verdict without branches, as in `positive_definite_shifted`
         let big = T::max_value().unwrap_or(T::one() / T::zero());
         let mut ok = true;
-        cholesky_in_place(&mut a, |d| {
+        cholesky_in_place::<T, D, false>(&mut a, |d| {
             ok &= (d > T::zero()) & (d <= big);
             d.sqrt()
         });
@@ -41,7 +41,7 @@ where
     #[inline(always)]
     pub(crate) fn semidefinite(mut a: OMatrix<T, D, D>, tol: T) -> Option<Self> {
         let mut ok = true;
-        cholesky_in_place(&mut a, |d| {
+        cholesky_in_place::<T, D, true>(&mut a, |d| {
             ok &= (d >= -tol) & d.is_finite();
             if d > tol { d.sqrt() } else { T::zero() }
         });
@@ -56,11 +56,14 @@ where
 
 /// The Cholesky-Banachiewicz loop in place on the lower triangle of `a` (the upper triangle
 /// set to zero): column `j`'s diagonal is `root(d_j)` of its pivot
-/// `d_j = a_jj - sum_(k<j) L_jk^2`, the entries below it are divided by that diagonal, or set
-/// to zero when it is zero (a zero column).
+/// `d_j = a_jj - sum_(k<j) L_jk^2`, the entries below it are divided by that diagonal, or,
+/// with `ZERO_COLUMNS`, set to zero when it is zero (a zero column; without it the loop has no
+/// branch, as the filters' factorisations want).
 #[inline(always)]
-fn cholesky_in_place<T, D>(a: &mut OMatrix<T, D, D>, mut root: impl FnMut(T) -> T)
-where
+fn cholesky_in_place<T, D, const ZERO_COLUMNS: bool>(
+    a: &mut OMatrix<T, D, D>,
+    mut root: impl FnMut(T) -> T,
+) where
     T: RealField + Copy,
     D: Dim,
     DefaultAllocator: Allocator<D, D>,
@@ -73,16 +76,18 @@ where
         }
         let ljj = root(d);
         a[(j, j)] = ljj;
-        for i in (j + 1)..n {
-            if ljj == T::zero() {
+        if ZERO_COLUMNS && ljj == T::zero() {
+            for i in (j + 1)..n {
                 a[(i, j)] = T::zero();
-                continue;
             }
-            let mut s = a[(i, j)];
-            for k in 0..j {
-                s -= a[(i, k)] * a[(j, k)];
+        } else {
+            for i in (j + 1)..n {
+                let mut s = a[(i, j)];
+                for k in 0..j {
+                    s -= a[(i, k)] * a[(j, k)];
+                }
+                a[(i, j)] = s / ljj;
             }
-            a[(i, j)] = s / ljj;
         }
         for i in 0..j {
             a[(i, j)] = T::zero();
