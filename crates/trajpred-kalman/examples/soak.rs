@@ -204,6 +204,11 @@ impl Soak {
         }
     }
 
+    /// `(steps, track_len, check_every, tamper)`.
+    pub fn parts(self) -> (u64, u64, u64, Option<Tamper>) {
+        (self.steps, self.track_len, self.check_every, self.tamper)
+    }
+
     /// The same run with `tamper` applied before every check.
     pub fn tampered(self, tamper: Tamper) -> Self {
         Soak {
@@ -275,12 +280,7 @@ fn run_track<D, F>(
 /// KF, constant velocity: `steps` steps in tracks of at most `track_len`.
 pub fn soak_kf(soak: Soak, rng: &mut ChaCha8Rng) -> Part {
     timed(|part| {
-        let Soak {
-            steps,
-            track_len,
-            check_every,
-            tamper,
-        } = soak;
+        let (steps, track_len, check_every, tamper) = soak.parts();
         let dt = 0.1;
         let tr: LinearTransition<f64, U4> =
             constant_velocity(2, dt, 0.5, StateOrder::AxisBlocks).expect("model");
@@ -329,12 +329,7 @@ pub fn soak_kf(soak: Soak, rng: &mut ChaCha8Rng) -> Part {
 /// UKF, coordinated turn; range-bearing observations on even tracks, positions on odd ones.
 pub fn soak_ukf(soak: Soak, rng: &mut ChaCha8Rng) -> Part {
     timed(|part| {
-        let Soak {
-            steps,
-            track_len,
-            check_every,
-            tamper,
-        } = soak;
+        let (steps, track_len, check_every, tamper) = soak.parts();
         let dt = 0.5;
         let ct = CoordinatedTurn::<f64>::new(dt, 0.2, 1e-3).expect("model");
         let truth = CoordinatedTurn::<f64>::new(dt, 0.0, 0.0).expect("model");
@@ -426,12 +421,7 @@ fn cv_filter(q: f64, r: f64) -> impl Fn(f64) -> Result<CvKf, KalmanError> {
 /// times so memory stays bounded.
 pub fn soak_driver(soak: Soak, rng: &mut ChaCha8Rng) -> Part {
     timed(|part| {
-        let Soak {
-            steps,
-            track_len,
-            check_every,
-            tamper,
-        } = soak;
+        let (steps, track_len, check_every, tamper) = soak.parts();
         let (q, r) = (0.5, 0.3);
         let chunk = 10_000usize;
         let mut left = steps;
@@ -540,12 +530,7 @@ pub fn soak_driver(soak: Soak, rng: &mut ChaCha8Rng) -> Part {
 /// observed step must be finite and the mode probabilities must sum to 1.
 pub fn soak_imm(soak: Soak, rng: &mut ChaCha8Rng) -> Part {
     timed(|part| {
-        let Soak {
-            steps,
-            track_len,
-            check_every,
-            tamper,
-        } = soak;
+        let (steps, track_len, check_every, tamper) = soak.parts();
         let (dt, q, pos_var) = (1.0, 0.05, 4.0);
         let obs = turn_state_position_observation::<f64>(pos_var).expect("model");
         let cv = Kf::new(
