@@ -1,26 +1,4 @@
-//! # trajpred-repro
-//!
-//! The experiments of trajpred's four source papers, as data and runners. Each runner
-//! regenerates a paper's tables and figures with trajpred's own implementations and returns
-//! them with the paper's reported figure beside ours ([`report::Table`]), the paper's claims
-//! decided from the run ([`report::Claim`]) and notes on why numbers differ.
-//! `cargo xtask reproduce` is a thin command over [`run_paper`], [`write_run`] (which writes a
-//! run under `target/reproduce/` by default), [`check_paper`] (`--check`: compares a fresh run
-//! with the one committed under `docs/results/` and fails on any difference beyond a column's
-//! tolerance, or any table, row, column, figure or claim on one side only) and [`bless`]
-//! (`--bless`: the only way `docs/results/` changes). Every file is written atomically
-//! ([`report::write_atomic`]).
-//!
-//! | paper | module | `docs/papers.md` |
-//! |---|---|---|
-//! | MSTPM-GSKF (group sparse coding + improved KF) | [`papers::gskf`] | A.5 |
-//! | Dynamic trajectory prediction with a KF | [`papers::kf_dynamic`] | B.4 |
-//! | MKPF (particle filter, UKF+EKF proposal) | [`papers::mkpf`] | C.2 |
-//! | KFU-LSTM-Net (Kalman-filter-unfolded LSTM) | [`papers::kfu_lstm`] | D.2 |
-//!
-//! Synthetic experiments always run; the real-data ones read `Context::data_dir` (the layout of
-//! `../shared/data`: `geolife/`, `tdrive/`, `adsb-traffic/`) and, when it is absent, say what
-//! to download and where to put it while the rest still runs.
+#![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 
 pub mod error;
