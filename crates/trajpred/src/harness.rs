@@ -161,58 +161,114 @@ pub fn history_at(tr: &Trajectory, origin: usize, history: usize) -> Result<Traj
     tr.slice(start..origin + 1)
 }
 
-fn evaluate_one(p: &dyn Predictor, tr: &Trajectory, cfg: &EvalConfig) -> Sums {
-    let mut s = Sums::new(cfg.horizon);
+/// Runs `p` at every origin of `tr` and hands `on` each origin's predicted and true points,
+/// or why the forecast was refused (a failed history, an error, a forecast of the wrong
+/// shape): the one loop both [`evaluate`] and [`collect_forecasts`] score through.
+fn each_origin(
+    p: &dyn Predictor,
+    tr: &Trajectory,
+    cfg: &EvalConfig,
+    mut on: impl FnMut(std::result::Result<(Vec<Point>, Vec<Point>), String>),
+) {
     for o in cfg.origins(tr.len()) {
         let history = match history_at(tr, o, cfg.history) {
             Ok(h) => h,
             Err(e) => {
-                s.failures += 1;
-                s.first_failure.get_or_insert_with(|| e.to_string());
+                on(Err(e.to_string()));
                 continue;
             }
         };
         let times = &tr.times()[o + 1..=o + cfg.horizon];
-        match p.forecast_times(&history, times) {
+        on(match p.forecast_times(&history, times) {
             Ok(f) if f.horizon() == cfg.horizon && f.dim() == tr.dim() => {
                 let predicted: Vec<Point> = f.points().collect();
                 let truth: Vec<Point> = (1..=cfg.horizon).map(|k| tr.point(o + k)).collect();
-                // every error through trajpred-metrics; a non-finite forecast is a failure
-                match trajpred_metrics::euclidean_errors(&predicted, &truth) {
-                    Ok(errors) => {
-                        s.forecasts += 1;
-                        for (k, e) in errors.into_iter().enumerate() {
-                            s.err[k] += e;
-                            s.err_sq[k] += e * e;
-                            s.hits[k] += usize::from(e < cfg.threshold);
-                        }
-                    }
-                    Err(e) => {
-                        s.failures += 1;
-                        s.first_failure
-                            .get_or_insert_with(|| format!("{}: {e}", p.name()));
-                    }
+                Ok((predicted, truth))
+            }
+            Ok(f) => Err(format!(
+                "forecast of {} steps x {} axes, expected {} x {}",
+                f.horizon(),
+                f.dim(),
+                cfg.horizon,
+                tr.dim()
+            )),
+            Err(e) => Err(e.to_string()),
+        });
+    }
+}
+
+fn evaluate_one(p: &dyn Predictor, tr: &Trajectory, cfg: &EvalConfig) -> Sums {
+    let mut s = Sums::new(cfg.horizon);
+    each_origin(p, tr, cfg, |r| {
+        // every error through trajpred-metrics; a non-finite forecast is a failure
+        let scored = r.and_then(|(predicted, truth)| {
+            trajpred_metrics::euclidean_errors(&predicted, &truth)
+                .map_err(|e| format!("{}: {e}", p.name()))
+        });
+        match scored {
+            Ok(errors) => {
+                s.forecasts += 1;
+                for (k, e) in errors.into_iter().enumerate() {
+                    s.err[k] += e;
+                    s.err_sq[k] += e * e;
+                    s.hits[k] += usize::from(e < cfg.threshold);
                 }
             }
-            Ok(f) => {
+            Err(why) => {
                 s.failures += 1;
-                s.first_failure.get_or_insert_with(|| {
-                    format!(
-                        "forecast of {} steps x {} axes, expected {} x {}",
-                        f.horizon(),
-                        f.dim(),
-                        cfg.horizon,
-                        tr.dim()
-                    )
-                });
-            }
-            Err(e) => {
-                s.failures += 1;
-                s.first_failure.get_or_insert_with(|| e.to_string());
+                s.first_failure.get_or_insert(why);
             }
         }
-    }
+    });
     s
+}
+
+/// One origin's forecast and the true points it is scored against, `horizon` each.
+pub type ForecastPair = (Vec<Point>, Vec<Point>);
+
+/// What [`collect_forecasts`] gives: every origin's pair, or why one forecast was refused.
+pub type Collected = std::result::Result<Vec<ForecastPair>, String>;
+
+/// Every forecast `predictor` makes on `test` under `cfg`, beside the true points, in the
+/// order of the trajectories and their origins (the same origins [`evaluate`] scores):
+/// `forecasts[i] = (predicted, truth)`, `horizon` points each. What a method that combines
+/// other methods' held-out forecasts learns from. The first refused or non-finite forecast
+/// is returned as `Err` with its reason, since a combination cannot skip it.
+pub fn collect_forecasts(
+    predictor: &dyn Predictor,
+    test: &[Trajectory],
+    cfg: &EvalConfig,
+) -> Result<Collected> {
+    cfg.validate()?;
+    let parts: Vec<_> = test
+        .par_iter()
+        .map(|tr| {
+            let mut out = Vec::new();
+            let mut failure = None;
+            each_origin(predictor, tr, cfg, |r| match r {
+                Ok((p, t)) if p.iter().all(|x| x.as_ref().iter().all(|c| c.is_finite())) => {
+                    out.push((p, t))
+                }
+                Ok(_) => {
+                    failure.get_or_insert_with(|| {
+                        format!("{}: non-finite forecast", predictor.name())
+                    });
+                }
+                Err(why) => {
+                    failure.get_or_insert(why);
+                }
+            });
+            failure.map_or(Ok(out), Err)
+        })
+        .collect();
+    let mut all = Vec::new();
+    for part in parts {
+        match part {
+            Ok(v) => all.extend(v),
+            Err(why) => return Ok(Err(why)),
+        }
+    }
+    Ok(Ok(all))
 }
 
 /// Number of trajectories evaluated in parallel at a time (and held in memory by

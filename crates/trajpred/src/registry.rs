@@ -93,6 +93,10 @@ pub const METHODS: &[MethodInfo] = &[
         description: "last velocity (last two points over their time difference), on the history's mean interval",
     },
     MethodInfo {
+        name: "last-position",
+        description: "persistence: the last position at every step",
+    },
+    MethodInfo {
         name: "poly1",
         description: "least-squares line through the last N points, extrapolated",
     },
@@ -127,6 +131,10 @@ pub const METHODS: &[MethodInfo] = &[
     MethodInfo {
         name: "auto",
         description: "the candidate with the lowest cross-validated error by user on the training part (see predictors::Auto)",
+    },
+    MethodInfo {
+        name: "blend",
+        description: "a weighted mean of the candidates' forecasts, weights per step chosen on forecasts held out by user (see predictors::Blend)",
     },
 ];
 
@@ -234,6 +242,7 @@ pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
             ..Default::default()
         })?),
         "cv-time" => Box::new(CvTime::new()),
+        "last-position" => Box::new(LastPosition::new()),
         "imm" => Box::new(ImmPredictor::new(ImmParams::default())?),
         "poly1" | "poly2" => Box::new(PolyFit::new(PolyFitParams {
             degree: if name == "poly1" { 1 } else { 2 },
@@ -259,6 +268,7 @@ pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
         })?),
         "hmm" => Box::new(Hmm::new(HmmParams {
             seed: opts.seed,
+            horizon: opts.eval.horizon,
             ..Default::default()
         })?),
         "aligned-ridge" => Box::new(AlignedRidge::new(AlignedRidgeParams {
@@ -269,6 +279,14 @@ pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
         })?),
         "auto" => Box::new(Auto::new(
             AutoParams {
+                seed: opts.seed,
+                eval: opts.eval,
+                ..Default::default()
+            },
+            opts.clone(),
+        )?),
+        "blend" => Box::new(Blend::new(
+            BlendParams {
                 seed: opts.seed,
                 eval: opts.eval,
                 ..Default::default()

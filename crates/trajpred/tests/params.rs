@@ -29,6 +29,8 @@ const METHODS: &[&str] = &[
     "mkpf",
     "aligned-ridge",
     "auto",
+    "blend",
+    "last-position",
 ];
 
 /// Segment `i`: 60 points at irregular times, a curve of its own.
@@ -144,7 +146,8 @@ fn loaded_parameters_forecast_bit_for_bit_as_the_fitted_methods() {
                 "hmm",
                 "imm",
                 "aligned-ridge",
-                "auto"
+                "auto",
+                "blend"
             ]
             .contains(name),
             "{name}"

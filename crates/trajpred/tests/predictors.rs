@@ -230,6 +230,16 @@ fn hmm_errors() {
         }),
         Err(Error::InvalidParameter { name: "states", .. })
     ));
+    assert!(matches!(
+        Hmm::new(HmmParams {
+            horizon: 0,
+            ..Default::default()
+        }),
+        Err(Error::InvalidParameter {
+            name: "horizon",
+            ..
+        })
+    ));
 }
 
 /// `cv-time` worked by hand: times 0, 2, 3, 7 give the mean interval Δ = 7 / 3 s; the last

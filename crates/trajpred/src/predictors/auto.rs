@@ -15,6 +15,7 @@ use trajpred_core::{Error, Forecast, Predictor, Result, Trajectory};
 /// to it).
 pub const DEFAULT_CANDIDATES: &[&str] = &[
     "cv-time",
+    "last-position",
     "naive-kf",
     "kf-dynamic-literal",
     "kf-cv",
@@ -352,23 +353,7 @@ impl Predictor for Auto {
                 self.params.candidates
             )));
         }
-        let mut p = registry::build(name, &self.options)?;
-        p.load_fitted_params(inner.value()).map_err(|e| match e {
-            Error::InvalidFitted {
-                method: m,
-                path,
-                reason,
-            } => Error::InvalidFitted {
-                method: "auto".into(),
-                path: if path.is_empty() {
-                    "params".into()
-                } else {
-                    format!("params.{path}")
-                },
-                reason: format!("{m}: {reason}"),
-            },
-            other => other,
-        })?;
+        let p = load_member("auto", name, &self.options, &inner)?;
         self.chosen = Some((name.to_string(), p));
         self.scores.clear();
         self.folds_used = 0;
@@ -404,6 +389,34 @@ impl Predictor for Auto {
         }
         Some(s)
     }
+}
+
+/// Builds `name` with `options` and loads its saved parameters from `inner` (a field of
+/// `method`'s own parameters); an error inside them is reported at its path under `inner`'s.
+pub(crate) fn load_member(
+    method: &str,
+    name: &str,
+    options: &MethodOptions,
+    inner: &At<'_>,
+) -> Result<Box<dyn Predictor>> {
+    let mut p = registry::build(name, options)?;
+    p.load_fitted_params(inner.value()).map_err(|e| match e {
+        Error::InvalidFitted {
+            method: m,
+            path,
+            reason,
+        } => Error::InvalidFitted {
+            method: method.into(),
+            path: if path.is_empty() {
+                inner.path().to_string()
+            } else {
+                format!("{}.{path}", inner.path())
+            },
+            reason: format!("{m}: {reason}"),
+        },
+        other => other,
+    })?;
+    Ok(p)
 }
 
 impl Auto {

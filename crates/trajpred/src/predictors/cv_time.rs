@@ -106,3 +106,55 @@ impl Predictor for CvTime {
         2
     }
 }
+
+/// Persistence: the target stays at its last position (`last-position` in the registry).
+///
+/// The plainest reference forecast there is, and the one a velocity extrapolation is
+/// shrunk towards: where fixes are minutes apart and a vehicle may have stopped (T-Drive
+/// taxis), a blend of the two ([`Blend`](super::Blend)) can beat both. Fits nothing.
+///
+/// ```
+/// use trajpred::predictors::LastPosition;
+/// use trajpred_core::{Predictor, Trajectory};
+/// let tr = Trajectory::from_axes(vec![0.0, 1.0], vec![vec![0.0, 1.0], vec![5.0, 6.0]])?;
+/// let f = LastPosition::new().forecast_times(&tr, &[2.0, 3.0])?;
+/// assert_eq!(f.step(2), &[1.0, 6.0]);
+/// # Ok::<(), trajpred_core::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct LastPosition;
+
+impl LastPosition {
+    /// The predictor (it has no parameters).
+    pub fn new() -> Self {
+        LastPosition
+    }
+}
+
+impl Predictor for LastPosition {
+    fn name(&self) -> &str {
+        "last-position"
+    }
+
+    fn fit(&mut self, _train: &[Trajectory]) -> Result<()> {
+        Ok(())
+    }
+
+    fn fitted_params(&self) -> Result<serde_json::Value> {
+        Ok(serde_json::Value::Null)
+    }
+
+    fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
+        trajpred_core::load_nothing(self.name(), params)
+    }
+
+    fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
+        check_forecast_args(history, horizon, self.min_history())?;
+        let last = history.point(history.len() - 1);
+        Forecast::new(history.dim(), vec![last.as_ref().to_vec(); horizon])
+    }
+
+    fn forecast_times(&self, history: &Trajectory, times: &[f64]) -> Result<Forecast> {
+        self.forecast(history, times.len())
+    }
+}

@@ -112,6 +112,11 @@ impl<'a> At<'a> {
             .collect())
     }
 
+    /// This field's JSON path (`""` at the root).
+    pub(crate) fn path(&self) -> &str {
+        &self.path
+    }
+
     /// The JSON value itself.
     pub(crate) fn value(&self) -> &'a Value {
         self.value

@@ -26,16 +26,25 @@ pub struct HmmParams {
     pub max_iterations: usize,
     /// Most recent displacements used by the forward filter.
     pub filter_window: usize,
+    /// Steps ahead K is chosen for: the mean position error over steps 1..=`horizon` of
+    /// forecasts on held-out training trajectories (the run's forecast horizon).
+    #[serde(default = "default_horizon")]
+    pub horizon: usize,
+}
+
+fn default_horizon() -> usize {
+    5
 }
 
 impl Default for HmmParams {
     fn default() -> Self {
         HmmParams {
             states: None,
-            candidates: vec![2, 4, 8, 16],
+            candidates: vec![2, 4, 8, 16, 32, 64, 128],
             seed: 0,
             max_iterations: 100,
             filter_window: 50,
+            horizon: default_horizon(),
         }
     }
 }
@@ -169,6 +178,9 @@ impl Hmm {
         }
         if params.filter_window == 0 {
             return Err(invalid("filter_window", "must be at least 1, got 0"));
+        }
+        if params.horizon == 0 {
+            return Err(invalid("horizon", "must be at least 1, got 0"));
         }
         Ok(Hmm {
             params,
@@ -484,16 +496,37 @@ impl Predictor for Hmm {
     }
 }
 
-/// Chooses K among the candidates by one-step-ahead error on held-out displacements: the last
-/// 20% of every training sequence (never the test data).
+/// Most held-out forecast origins K is scored on (spread evenly over the held-out
+/// trajectories), which bounds the cost of choosing among large K.
+const CHOOSE_K_ORIGINS: usize = 4000;
+
+/// Chooses K among the candidates by the error the forecasts are judged by: the mean position
+/// error over steps 1..=`horizon` of forecasts on held-out training trajectories (every fifth
+/// one; the last 20 % of every sequence when there are fewer than five), each K fitted on
+/// the rest. Never the test data.
 fn choose_k(seqs: &[Vec<Vec<f64>>], params: &HmmParams) -> Result<usize> {
-    let (fit, held): (Vec<_>, Vec<_>) = seqs
+    let (fit, held): (Vec<_>, Vec<_>) = if seqs.len() >= 5 {
+        let (f, h): (Vec<_>, Vec<_>) = seqs.iter().enumerate().partition(|(i, _)| i % 5 != 4);
+        (
+            f.into_iter().map(|(_, s)| s.clone()).collect(),
+            h.into_iter().map(|(_, s)| s.clone()).collect(),
+        )
+    } else {
+        seqs.iter()
+            .map(|s| {
+                let cut = (s.len() * 4).div_ceil(5).max(1);
+                (s[..cut].to_vec(), s[cut..].to_vec())
+            })
+            .unzip()
+    };
+    let h = params.horizon;
+    // (sequence, displacements seen) of every held-out origin with `h` displacements after it
+    let origins: Vec<(usize, usize)> = held
         .iter()
-        .map(|s| {
-            let cut = (s.len() * 4).div_ceil(5).max(1);
-            (s[..cut].to_vec(), s[cut..].to_vec())
-        })
-        .unzip();
+        .enumerate()
+        .flat_map(|(i, s)| (1..=s.len().saturating_sub(h)).map(move |j| (i, j)))
+        .collect();
+    let stride = origins.len().div_ceil(CHOOSE_K_ORIGINS).max(1);
     let total_fit: usize = fit.iter().map(Vec::len).sum();
     let mut best: Option<(usize, f64)> = None;
     for &k in &params.candidates {
@@ -502,15 +535,18 @@ fn choose_k(seqs: &[Vec<Vec<f64>>], params: &HmmParams) -> Result<usize> {
         }
         let model = train(&fit, k, params)?;
         let (mut err, mut n) = (0.0, 0usize);
-        for (f, h) in fit.iter().zip(&held) {
-            let mut seq = f.clone();
-            for d in h {
-                let start = seq.len().saturating_sub(params.filter_window);
-                let dist = model.filter(&seq[start..]);
-                let pred = &model.expected_displacements(dist, 1)[0];
-                err += sq_dist(pred, d).sqrt();
+        for &(i, j) in origins.iter().step_by(stride) {
+            let seq = &held[i];
+            let recent = &seq[j.saturating_sub(params.filter_window)..j];
+            let pred = model.expected_displacements(model.filter(recent), h);
+            let (mut p, mut t) = (vec![0.0; model.dim], vec![0.0; model.dim]);
+            for (step, d) in pred.iter().zip(&seq[j..j + h]) {
+                for a in 0..model.dim {
+                    p[a] += step[a];
+                    t[a] += d[a];
+                }
+                err += sq_dist(&p, &t).sqrt();
                 n += 1;
-                seq.push(d.clone());
             }
         }
         let score = if n > 0 { err / n as f64 } else { f64::INFINITY };

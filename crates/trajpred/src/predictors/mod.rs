@@ -2,6 +2,7 @@
 
 mod aligned_ridge;
 mod auto;
+mod blend;
 mod cv_time;
 mod fitted;
 mod gskf;
@@ -14,7 +15,8 @@ mod poly;
 
 pub use aligned_ridge::{AlignedRidge, AlignedRidgeParams};
 pub use auto::{Auto, AutoParams, CandidateScore, DEFAULT_CANDIDATES, cross_validate};
-pub use cv_time::CvTime;
+pub use blend::{Blend, BlendParams};
+pub use cv_time::{CvTime, LastPosition};
 pub use gskf::{Gsc, Gskf, GskfParams};
 pub use hmm::{Hmm, HmmParams, MAX_HMM_STATES};
 pub use imm::{ImmParams, ImmPredictor};
