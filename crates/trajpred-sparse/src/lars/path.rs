@@ -26,9 +26,10 @@ pub(super) struct Core<'a> {
     xty: Option<Vec<f64>>,
     /// `||x_j||^2`.
     sq_norms: Vec<f64>,
-    /// Scratch without the Gram matrix: the equiangular vector `u = X_A w` (length n), the
-    /// eligible inactive columns and their `a_j`.
+    /// Scratch without the Gram matrix: the equiangular vector `u = X_A w` (length n).
     u: Vec<f64>,
+    /// The eligible inactive columns, in increasing order (kept up to date by `run`), and
+    /// their `a_j`.
     inactive: Vec<usize>,
     a_inactive: Vec<f64>,
     /// With the Gram matrix: `G[gc_rows, :]` (column-major), a superset of the inactive
@@ -89,8 +90,9 @@ impl<'a> Core<'a> {
         }
     }
 
-    /// `a = X^T X_A w` for the eligible inactive columns (from the Gram matrix's rows of
-    /// those columns, or from `u = X_A w`), and `a_j = aa s_j` (eq. 2.6) on the active set.
+    /// `a = X^T X_A w` for the eligible inactive columns (`self.inactive`; from the Gram
+    /// matrix's rows of those columns, or from `u = X_A w`), and `a_j = aa s_j` (eq. 2.6) on
+    /// the active set.
     #[allow(clippy::too_many_arguments)]
     fn equiangular_correlations(
         &mut self,
@@ -98,11 +100,8 @@ impl<'a> Core<'a> {
         w: &[f64],
         signs: &[f64],
         aa: f64,
-        usable: impl Fn(usize) -> bool,
         a: &mut [f64],
     ) {
-        self.inactive.clear();
-        self.inactive.extend((0..self.p).filter(|&j| usable(j)));
         match &self.gram {
             Some(g) => {
                 // rows of G for the inactive columns only (sklearn keeps them apart by
@@ -207,9 +206,12 @@ impl<'a> Core<'a> {
                 c[j] = v;
             }
         }
-        let c0 = (0..p)
-            .filter(|&j| eligible[j])
-            .map(|j| c[j].abs())
+        self.inactive.clear();
+        self.inactive.extend((0..p).filter(|&j| eligible[j]));
+        let c0 = self
+            .inactive
+            .iter()
+            .map(|&j| c[j].abs())
             .fold(0.0, f64::max);
 
         let mut beta = vec![0.0; p];
@@ -221,7 +223,6 @@ impl<'a> Core<'a> {
         let mut events = Vec::new();
         let mut active: Vec<usize> = Vec::new();
         let mut signs: Vec<f64> = Vec::new();
-        let mut is_active = vec![false; p];
         let mut chol = CholeskyFactor::default();
         // z = L^{-1} s, extended on each entry, recomputed after drops (the downdate changes L)
         let mut z: Vec<f64> = Vec::new();
@@ -230,6 +231,9 @@ impl<'a> Core<'a> {
         let mut big_c = c0;
         let mut step = 0usize;
         let mut scratch = Vec::new();
+        let mut candidates: Vec<usize> = Vec::new();
+        let mut w: Vec<f64> = Vec::new();
+        let mut drops: Vec<usize> = Vec::new(); // positions in `active`
         let mut a = vec![0.0; p];
 
         let finish = |alphas, coefs, events, active, stop, chol| Path {
@@ -275,34 +279,34 @@ impl<'a> Core<'a> {
 
             // --- variables that tie for the largest correlation enter -------------------------
             let threshold = big_c * (1.0 - params.tie_tolerance);
-            let mut candidates: Vec<usize> = (0..p)
-                .filter(|&j| {
-                    eligible[j]
-                        && !is_active[j]
-                        && !just_dropped.contains(&j)
-                        && c[j].abs() >= threshold
-                })
-                .collect();
+            candidates.clear();
+            candidates.extend(
+                self.inactive
+                    .iter()
+                    .copied()
+                    .filter(|&j| c[j].abs() >= threshold && !just_dropped.contains(&j)),
+            );
             candidates.sort_by(|&i, &j| c[j].abs().total_cmp(&c[i].abs()).then(i.cmp(&j)));
             if z_stale {
                 z.clone_from(&signs);
                 chol.forward_in_place(&mut z);
                 z_stale = false;
             }
-            for j in candidates {
+            for &j in &candidates {
                 self.gram_with_active(&active, j, &mut scratch);
                 match chol.append(&scratch, self.sq_norms[j], params.collinearity_tolerance) {
                     Append::Appended => {
+                        remove_sorted(&mut self.inactive, j);
                         active.push(j);
                         let sj = if c[j] >= 0.0 { 1.0 } else { -1.0 };
                         signs.push(sj);
                         // the factor grew by one row: z = L^{-1} s grows by one entry, the
                         // same value a full forward solve would give
                         chol.forward_extend(&mut z, sj);
-                        is_active[j] = true;
                         events.push(PathEvent::Added { feature: j, step });
                     }
                     Append::Collinear => {
+                        remove_sorted(&mut self.inactive, j);
                         eligible[j] = false;
                         excluded.push(Exclusion {
                             feature: j,
@@ -325,7 +329,7 @@ impl<'a> Core<'a> {
             }
 
             // --- equiangular direction: w = AA G_AA^{-1} s ---------------------------------
-            let mut w = z.clone();
+            w.clone_from(&z);
             chol.backward_in_place(&mut w);
             let q: f64 = w.iter().zip(&signs).map(|(wi, si)| wi * si).sum();
             if !(q.is_finite() && q > 0.0) {
@@ -340,14 +344,7 @@ impl<'a> Core<'a> {
             }
             let aa = 1.0 / q.sqrt();
             w.iter_mut().for_each(|v| *v *= aa);
-            self.equiangular_correlations(
-                &active,
-                &w,
-                &signs,
-                aa,
-                |j| eligible[j] && !is_active[j],
-                &mut a,
-            );
+            self.equiangular_correlations(&active, &w, &signs, aa, &mut a);
 
             // --- step length --------------------------------------------------------------
             let gamma_hat = big_c / aa;
@@ -364,8 +361,10 @@ impl<'a> Core<'a> {
                     let num = big_c - side * c[j];
                     let den = aa - side * a[j];
                     // the division only when it may shorten the step: num / den < gamma
-                    // implies num < gamma den (1 + 4 eps) whatever the rounding
-                    if num > 0.0 && den > 0.0 && num < gamma * den * (1.0 + 4.0 * f64::EPSILON) {
+                    // implies num < gamma den (1 + 4 eps) whatever the rounding (`&`, not
+                    // `&&`: one rarely taken branch instead of three unpredictable ones)
+                    if (num > 0.0) & (den > 0.0) & (num < gamma * den * (1.0 + 4.0 * f64::EPSILON))
+                    {
                         let g = num / den;
                         if g < gamma {
                             gamma = g;
@@ -374,7 +373,7 @@ impl<'a> Core<'a> {
                 }
             }
             // lasso: the first active coefficient to reach zero
-            let mut drops: Vec<usize> = Vec::new(); // positions in `active`
+            drops.clear();
             if params.method == Method::Lasso {
                 let mut z_min = f64::INFINITY;
                 for (pos, &j) in active.iter().enumerate() {
@@ -418,7 +417,7 @@ impl<'a> Core<'a> {
                 signs.remove(pos);
                 chol.remove(pos);
                 z_stale = true;
-                is_active[j] = false;
+                insert_sorted(&mut self.inactive, j);
                 beta[j] = 0.0;
                 just_dropped.push(j);
                 events.push(PathEvent::Dropped { feature: j, step });
@@ -453,5 +452,19 @@ impl<'a> Core<'a> {
                 return finish(alphas, coefs, events, active, stop, chol);
             }
         }
+    }
+}
+
+/// Removes `j` from the increasing list `list` (if present).
+fn remove_sorted(list: &mut Vec<usize>, j: usize) {
+    if let Ok(pos) = list.binary_search(&j) {
+        list.remove(pos);
+    }
+}
+
+/// Inserts `j` into the increasing list `list` (if absent).
+fn insert_sorted(list: &mut Vec<usize>, j: usize) {
+    if let Err(pos) = list.binary_search(&j) {
+        list.insert(pos, j);
     }
 }
