@@ -1,6 +1,7 @@
 //! The path itself, on the standardised problem: the LAR / lasso steps with an incrementally
 //! updated Cholesky factor, with or without the Gram matrix, and the final refinement.
 
+use super::knots::Knots;
 use super::{Exclusion, ExclusionReason, LarsParams, Method, PathEvent, StopReason};
 use crate::cholesky::{Append, CholeskyFactor};
 use crate::kernels::{self, dot};
@@ -9,7 +10,7 @@ use nalgebra::DMatrix;
 pub(super) struct Path {
     pub(super) alphas: Vec<f64>,
     /// knot after knot, `p` coefficients each
-    pub(super) coefs: Vec<f64>,
+    pub(super) coefs: Knots,
     pub(super) events: Vec<PathEvent>,
     pub(super) active: Vec<usize>,
     pub(super) stop: StopReason,
@@ -20,8 +21,9 @@ pub(super) struct Core<'a> {
     xs: &'a DMatrix<f64>,
     n: usize,
     p: usize,
-    /// `X^T X` (column-major p x p), when precomputed.
+    /// `X^T X` (column-major p x p, column stride `ld`), when precomputed.
     gram: Option<Vec<f64>>,
+    ld: usize,
     /// `X^T y`, computed with the Gram matrix.
     xty: Option<Vec<f64>>,
     /// `||x_j||^2`.
@@ -43,14 +45,14 @@ impl<'a> Core<'a> {
     /// With `use_gram`, `X^T X` and `X^T ys` are computed here, in one pass over `X`.
     pub(super) fn new(xs: &'a DMatrix<f64>, ys: &[f64], use_gram: bool) -> Self {
         let (n, p) = xs.shape();
-        let (gram, xty) = if use_gram {
-            let (g, xty) = kernels::gram(xs.as_slice(), n, p, ys);
-            (Some(g), Some(xty))
+        let (gram, ld, xty) = if use_gram {
+            let (g, ld, xty) = kernels::gram(xs.as_slice(), n, p, ys);
+            (Some(g), ld, Some(xty))
         } else {
-            (None, None)
+            (None, p, None)
         };
         let sq_norms = match &gram {
-            Some(g) => (0..p).map(|j| g[j * p + j]).collect(),
+            Some(g) => (0..p).map(|j| g[j * ld + j]).collect(),
             None => (0..p)
                 .map(|j| {
                     let c = &xs.as_slice()[j * n..(j + 1) * n];
@@ -63,6 +65,7 @@ impl<'a> Core<'a> {
             n,
             p,
             gram,
+            ld,
             xty,
             sq_norms,
             u: vec![0.0; if use_gram { 0 } else { n }],
@@ -82,7 +85,7 @@ impl<'a> Core<'a> {
     fn gram_with_active(&self, active: &[usize], j: usize, out: &mut Vec<f64>) {
         out.clear();
         match &self.gram {
-            Some(g) => out.extend(active.iter().map(|&a| g[j * self.p + a])),
+            Some(g) => out.extend(active.iter().map(|&a| g[j * self.ld + a])),
             None => {
                 out.resize(active.len(), 0.0);
                 kernels::dots(self.xs.as_slice(), self.n, active, self.col(j), out);
@@ -107,7 +110,7 @@ impl<'a> Core<'a> {
                 // rows of G for the inactive columns only (sklearn keeps them apart by
                 // swapping rows of G): a compacted copy, rebuilt when a quarter of its rows
                 // has become active or a dropped column needs a row it lacks
-                let p = self.p;
+                let (p, ld) = (self.p, self.ld);
                 let stale = self.inactive.len() * 4 < self.gc_rows.len() * 3
                     || self.inactive.iter().any(|&j| !self.in_gc[j]);
                 if stale {
@@ -119,7 +122,7 @@ impl<'a> Core<'a> {
                     let m = self.gc_rows.len();
                     self.gc.resize(m * p, 0.0);
                     for (k, gk) in self.gc.chunks_exact_mut(m.max(1)).enumerate().take(p) {
-                        let src = &g[k * p..(k + 1) * p];
+                        let src = &g[k * ld..k * ld + p];
                         for (dst, &j) in gk.iter_mut().zip(&self.gc_rows) {
                             *dst = src[j];
                         }
@@ -218,8 +221,8 @@ impl<'a> Core<'a> {
         let mut alphas = vec![c0 / nf];
         // room for the knots of a full LAR path (the lasso may need more), within reason
         let knots_guess = self.n.min(p).min(params.max_steps.unwrap_or(usize::MAX)) + 2;
-        let mut coefs = Vec::with_capacity(p.saturating_mul(knots_guess).min(1 << 24));
-        coefs.extend_from_slice(&beta);
+        let mut coefs = Knots::with_capacity(p, knots_guess.min((1 << 24) / p.max(1)));
+        coefs.push(&beta);
         let mut events = Vec::new();
         let mut active: Vec<usize> = Vec::new();
         let mut signs: Vec<f64> = Vec::new();
@@ -426,7 +429,7 @@ impl<'a> Core<'a> {
             let alpha = big_c / nf;
             let prev_alpha = alphas[alphas.len() - 1];
             if params.alpha_min > 0.0 && alpha <= params.alpha_min {
-                let prev = &coefs[coefs.len() - p..];
+                let prev = coefs.knot(coefs.len() - 1);
                 let ss = if prev_alpha > alpha {
                     (prev_alpha - params.alpha_min) / (prev_alpha - alpha)
                 } else {
@@ -438,11 +441,11 @@ impl<'a> Core<'a> {
                     .map(|(b0, b1)| b0 + ss * (b1 - b0))
                     .collect();
                 alphas.push(params.alpha_min);
-                coefs.extend_from_slice(&knot);
+                coefs.push(&knot);
                 return finish(alphas, coefs, events, active, StopReason::AlphaMin, chol);
             }
             alphas.push(alpha);
-            coefs.extend_from_slice(&beta);
+            coefs.push(&beta);
             if full_step {
                 let stop = if any_inactive {
                     StopReason::CorrelationVanished
