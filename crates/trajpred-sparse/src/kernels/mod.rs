@@ -431,7 +431,8 @@ impl WithSimd for Backward<'_> {
                 for k in 0..BACK_GROUP {
                     nx[k] = simd.splat_f64s(-xs[k]);
                 }
-                let rh: [&[S::f64s]; BACK_GROUP] = std::array::from_fn(|k| S::as_simd_f64s(rs[k]).0);
+                let rh: [&[S::f64s]; BACK_GROUP] =
+                    std::array::from_fn(|k| S::as_simd_f64s(rs[k]).0);
                 let (zh, zt) = S::as_mut_simd_f64s(&mut z[..g0]);
                 let done = zh.len() * S::F64_LANES;
                 for (r, zv) in zh.iter_mut().enumerate() {

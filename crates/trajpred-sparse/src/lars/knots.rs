@@ -96,7 +96,17 @@ mod tests {
         // room for 2 knots: the third and fifth push grow it
         let mut k = Knots::with_capacity(p, 2);
         let rows: Vec<Vec<f64>> = (0..5)
-            .map(|r| (0..p).map(|j| if (r + j) % 2 == 0 { 0.0 } else { (r * 10 + j) as f64 }).collect())
+            .map(|r| {
+                (0..p)
+                    .map(|j| {
+                        if (r + j) % 2 == 0 {
+                            0.0
+                        } else {
+                            (r * 10 + j) as f64
+                        }
+                    })
+                    .collect()
+            })
             .collect();
         for r in &rows {
             k.push(r);
