@@ -150,12 +150,13 @@ impl WithSimd for GramPacked<'_> {
     }
 }
 
-/// `X^T X` (p x p, column-major, symmetric) of the column-major `data` (`n` rows, `p`
-/// columns), and `X^T extra` (`extra.len() == n`) from the same pass over `X`: the upper block
-/// triangle of `[X extra]^T [X extra]` by a register-blocked kernel over packed chunks of rows
-/// (see [`GRAM_ROWS`]), then mirrored. Every entry is one chain of fused multiply-adds over
-/// the rows in order, whichever block computed it.
-pub(crate) fn gram(data: &[f64], n: usize, p: usize, extra: &[f64]) -> (Vec<f64>, Vec<f64>) {
+/// `X^T X` (p x p, symmetric) of the column-major `data` (`n` rows, `p` columns), stored
+/// column-major with column stride `ld >= p` (entry `(i, j)` at `j * ld + i`), and `X^T extra`
+/// (`extra.len() == n`) from the same pass over `X`: the upper block triangle of
+/// `[X extra]^T [X extra]` by a register-blocked kernel over packed chunks of rows (see
+/// [`GRAM_ROWS`]), then mirrored in place. Every entry is one chain of fused multiply-adds over
+/// the rows in order, whichever block computed it. Returns `(G, ld, X^T extra)`.
+pub(crate) fn gram(data: &[f64], n: usize, p: usize, extra: &[f64]) -> (Vec<f64>, usize, Vec<f64>) {
     debug_assert_eq!(extra.len(), n);
     let l = lanes();
     let pl = (p + 1).div_ceil(l) * l;
@@ -170,16 +171,19 @@ pub(crate) fn gram(data: &[f64], n: usize, p: usize, extra: &[f64]) -> (Vec<f64>
             g: &mut gp,
         });
     }
-    let mut g = vec![0.0; p * p];
-    for j in 0..p {
-        for i in 0..=j {
-            let v = gp[j * pl + i];
-            g[j * p + i] = v;
-            g[i * p + j] = v;
+    let xty = gp[p * pl..p * pl + p].to_vec();
+    // the lower triangle from the upper one, by tiles (both sides stay in cache)
+    const TILE: usize = 32;
+    for j0 in (0..p).step_by(TILE) {
+        for i0 in (0..=j0).step_by(TILE) {
+            for j in j0..(j0 + TILE).min(p) {
+                for i in i0..(i0 + TILE).min(j) {
+                    gp[i * pl + j] = gp[j * pl + i];
+                }
+            }
         }
     }
-    let xty = gp[p * pl..p * pl + p].to_vec();
-    (g, xty)
+    (gp, pl, xty)
 }
 
 struct Lanes;

@@ -17,7 +17,7 @@ use pulp::{Arch, Simd, WithSimd};
 /// Columns per pass in [`dots`] and [`combine`].
 const GROUP: usize = 4;
 /// Columns per pass in [`combine`]: each pass reads and writes `out` once.
-const COMBINE_GROUP: usize = 4;
+const COMBINE_GROUP: usize = 8;
 
 #[inline]
 fn arch() -> Arch {
@@ -36,30 +36,31 @@ fn dot_with<S: Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
     dots_with::<S, 1>(simd, [&a[..n]], &b[..n])[0]
 }
 
-/// `a . b` with four chains (the latency-bound rows of a triangular solve).
+/// `rows[k][..m] . b` for `K` rows at once (`m = b.len()`): `b` is loaded once per vector for
+/// all the rows, one chain per row (`K` independent chains), so that each row is summed in the
+/// same order whatever `K` (the rows of a triangular solve, and one of them alone).
 #[inline(always)]
-fn dot4_with<S: Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    let (ah, at) = S::as_simd_f64s(&a[..n]);
-    let (bh, bt) = S::as_simd_f64s(&b[..n]);
+fn row_dots_with<S: Simd, const K: usize>(simd: S, rows: [&[f64]; K], b: &[f64]) -> [f64; K] {
+    let m = b.len();
+    let (bh, bt) = S::as_simd_f64s(b);
+    let heads: [&[S::f64s]; K] = std::array::from_fn(|k| S::as_simd_f64s(&rows[k][..m]).0);
     let z = simd.splat_f64s(0.0);
-    let mut acc = [z; 4];
-    let mut ac = ah.chunks_exact(4);
-    let mut bc = bh.chunks_exact(4);
-    for (x, y) in (&mut ac).zip(&mut bc) {
-        for u in 0..4 {
-            acc[u] = simd.mul_add_e_f64s(x[u], y[u], acc[u]);
+    let mut acc = [z; K];
+    for (i, bv) in bh.iter().enumerate() {
+        for k in 0..K {
+            acc[k] = simd.mul_add_e_f64s(heads[k][i], *bv, acc[k]);
         }
     }
-    for (x, y) in ac.remainder().iter().zip(bc.remainder()) {
-        acc[0] = simd.mul_add_e_f64s(*x, *y, acc[0]);
+    let done = bh.len() * S::F64_LANES;
+    let mut out = [0.0; K];
+    for k in 0..K {
+        let mut r = simd.reduce_sum_f64s(acc[k]);
+        for (x, y) in rows[k][done..m].iter().zip(bt) {
+            r += x * y;
+        }
+        out[k] = r;
     }
-    let s = simd.add_f64s(simd.add_f64s(acc[0], acc[1]), simd.add_f64s(acc[2], acc[3]));
-    let mut r = simd.reduce_sum_f64s(s);
-    for (x, y) in at.iter().zip(bt) {
-        r += x * y;
-    }
-    r
+    out
 }
 
 struct Dot<'a>(&'a [f64], &'a [f64]);
@@ -251,9 +252,9 @@ fn combine_into<S: Simd>(
 // ---------------------------------------------------------------------------------------
 // X_S^T (y - X_S b) in one pass over X_S
 
-/// Rows per block of [`residual_dots`]: a block of up to 500 columns stays in L2 between
-/// its two uses.
-const RESIDUAL_ROWS: usize = 512;
+/// Rows per block of [`residual_dots`]: a block of up to 500 columns (1 MiB) stays in a 2 MiB
+/// L2 cache between its two uses.
+const RESIDUAL_ROWS: usize = 256;
 
 /// `out = X_S^T (y - X_S b)` by blocks of [`RESIDUAL_ROWS`] rows.
 #[inline(always)]
@@ -335,7 +336,7 @@ const SOLVE_BLOCK: usize = 8;
 #[inline(always)]
 fn forward_dot_with<S: Simd>(simd: S, row: &[f64], b: &[f64], i: usize) -> f64 {
     let i0 = i / SOLVE_BLOCK * SOLVE_BLOCK;
-    let mut s = dot4_with(simd, &row[..i0], &b[..i0]);
+    let [mut s] = row_dots_with(simd, [&row[..i0]], &b[..i0]);
     for (r, x) in row[i0..i].iter().zip(&b[i0..i]) {
         s += r * x;
     }
@@ -355,11 +356,12 @@ impl WithSimd for Forward<'_> {
         let mut i0 = 0;
         while i0 < rows.len() {
             let i1 = (i0 + SOLVE_BLOCK).min(rows.len());
-            // the block's dot products with b[..i0] first (independent of each other) ...
-            let mut head = [0.0; SOLVE_BLOCK];
-            for (h, row) in head.iter_mut().zip(&rows[i0..i1]) {
-                *h = dot4_with(simd, &row[..i0], &b[..i0]);
-            }
+            // the block's dot products with b[..i0] first, all at once (a short last block
+            // repeats its last row) ...
+            let block = &rows[i0..i1];
+            let heads: [&[f64]; SOLVE_BLOCK] =
+                std::array::from_fn(|k| &block[k.min(block.len() - 1)][..i0]);
+            let head = row_dots_with(simd, heads, &b[..i0]);
             // ... then the triangle inside the block, in order (= forward_dot_with)
             for (i, row) in rows.iter().enumerate().take(i1).skip(i0) {
                 let mut s = head[i - i0];
@@ -394,6 +396,9 @@ pub(crate) fn forward_dot(row: &[f64], b: &[f64], i: usize) -> f64 {
     arch().dispatch(ForwardDot(row, b, i))
 }
 
+/// Rows per group of the backward solve.
+const BACK_GROUP: usize = 4;
+
 struct Backward<'a> {
     rows: &'a [Vec<f64>],
     z: &'a mut [f64],
@@ -404,19 +409,46 @@ impl WithSimd for Backward<'_> {
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) {
         let Backward { rows, z } = self;
-        for i in (0..rows.len()).rev() {
-            let row = &rows[i];
-            let xi = z[i] / row[i];
-            z[i] = xi;
-            let (zh, zt) = S::as_mut_simd_f64s(&mut z[..i]);
-            let (rh, rt) = S::as_simd_f64s(&row[..i]);
-            let nx = simd.splat_f64s(-xi);
-            for (zv, rv) in zh.iter_mut().zip(rh) {
-                *zv = simd.mul_add_e_f64s(nx, *rv, *zv);
+        // groups of BACK_GROUP rows from the bottom of the factor: the triangle inside a group
+        // in order, then the group's rows leave the entries above it in one pass over `z`
+        // (each entry takes the rows' products in the same order as row by row)
+        let mut i1 = rows.len();
+        while i1 > 0 {
+            let g0 = i1.saturating_sub(BACK_GROUP);
+            for i in (g0..i1).rev() {
+                let row = &rows[i];
+                let xi = z[i] / row[i];
+                z[i] = xi;
+                for (zj, rj) in z[g0..i].iter_mut().zip(&row[g0..i]) {
+                    *zj -= rj * xi;
+                }
             }
-            for (zv, rv) in zt.iter_mut().zip(rt) {
-                *zv -= rv * xi;
+            if g0 > 0 {
+                // a full group (only the top rows of the factor make a short one, at g0 = 0)
+                let rs: [&[f64]; BACK_GROUP] = std::array::from_fn(|k| &rows[i1 - 1 - k][..g0]);
+                let xs: [f64; BACK_GROUP] = std::array::from_fn(|k| z[i1 - 1 - k]);
+                let mut nx = [simd.splat_f64s(0.0); BACK_GROUP];
+                for k in 0..BACK_GROUP {
+                    nx[k] = simd.splat_f64s(-xs[k]);
+                }
+                let rh: [&[S::f64s]; BACK_GROUP] =
+                    std::array::from_fn(|k| S::as_simd_f64s(rs[k]).0);
+                let (zh, zt) = S::as_mut_simd_f64s(&mut z[..g0]);
+                let done = zh.len() * S::F64_LANES;
+                for (r, zv) in zh.iter_mut().enumerate() {
+                    let mut acc = *zv;
+                    for k in 0..BACK_GROUP {
+                        acc = simd.mul_add_e_f64s(nx[k], rh[k][r], acc);
+                    }
+                    *zv = acc;
+                }
+                for (j, zv) in zt.iter_mut().enumerate() {
+                    for k in 0..BACK_GROUP {
+                        *zv -= rs[k][done + j] * xs[k];
+                    }
+                }
             }
+            i1 = g0;
         }
     }
 }

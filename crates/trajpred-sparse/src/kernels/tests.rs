@@ -64,7 +64,7 @@ fn kernels_agree_with_plain_loops_on_awkward_sizes() {
                 rd[k]
             );
         }
-        let (g, xtv) = gram(&x, n, p, &v);
+        let (g, ld, xtv) = gram(&x, n, p, &v);
         for j in 0..p {
             let want = naive_dot(&x[j * n..(j + 1) * n], &v);
             assert!(close(xtv[j], want), "gram X^T v {n}x{p} col {j}");
@@ -72,7 +72,7 @@ fn kernels_agree_with_plain_loops_on_awkward_sizes() {
         for i in 0..p {
             for j in 0..p {
                 let want = naive_dot(&x[i * n..(i + 1) * n], &x[j * n..(j + 1) * n]);
-                assert!(close(g[j * p + i], want), "gram {n}x{p} ({i}, {j})");
+                assert!(close(g[j * ld + i], want), "gram {n}x{p} ({i}, {j})");
             }
         }
     }

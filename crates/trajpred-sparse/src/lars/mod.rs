@@ -7,6 +7,7 @@
 //! path; `sklearn.rs` [`lars_path`].
 
 mod fitted;
+mod knots;
 mod path;
 mod sklearn;
 
@@ -356,17 +357,20 @@ impl LarsParams {
         if matches!(
             path.stop,
             StopReason::Complete | StopReason::CorrelationVanished
-        ) && let Some(last) = path.coefs.rchunks_exact_mut(p).next()
+        ) && let Some(k) = path.coefs.len().checked_sub(1)
         {
-            core.refine(&path.active, &path.chol, &ys, last);
+            let mut last = path.coefs.knot(k);
+            core.refine(&path.active, &path.chol, &ys, &mut last);
+            path.coefs.set_knot(k, &last);
         }
         excluded.sort_by_key(|e| e.feature);
 
         // --- back to the original scale ---------------------------------------------------
         let knots = path.alphas.len();
-        // row-major knots x p (one knot after another): transposed into the column-major
-        // matrices once, and checked with one linear scan each
-        let std_path = knots_by_features(&path.coefs, knots, p);
+        // the knots were stored column-major (knots x p) as they came: each matrix is checked
+        // with one linear scan
+        let std_path = path.coefs.into_matrix();
+        debug_assert_eq!(std_path.nrows(), knots);
         // without scaling the original-scale path is the same matrix: stored once
         let coef_path = if x_scale.iter().all(|&s| s == 1.0) {
             None
@@ -431,25 +435,6 @@ impl LarsParams {
             y_mean,
         })
     }
-}
-
-/// The knot-major buffer (`knots` rows of `p`) as a `knots x p` matrix, transposed by tiles
-/// of 64 knots so that both sides stream through the cache.
-fn knots_by_features(flat: &[f64], knots: usize, p: usize) -> DMatrix<f64> {
-    const TILE: usize = 64;
-    let mut m = DMatrix::zeros(knots, p);
-    let dst = m.as_mut_slice();
-    let mut k0 = 0;
-    while k0 < knots {
-        let k1 = (k0 + TILE).min(knots);
-        for j in 0..p {
-            for k in k0..k1 {
-                dst[j * knots + k] = flat[k * p + j];
-            }
-        }
-        k0 = k1;
-    }
-    m
 }
 
 /// The index at which the running sum of `values` first stops being finite (the last index if

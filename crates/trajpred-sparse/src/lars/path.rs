@@ -1,6 +1,7 @@
 //! The path itself, on the standardised problem: the LAR / lasso steps with an incrementally
 //! updated Cholesky factor, with or without the Gram matrix, and the final refinement.
 
+use super::knots::Knots;
 use super::{Exclusion, ExclusionReason, LarsParams, Method, PathEvent, StopReason};
 use crate::cholesky::{Append, CholeskyFactor};
 use crate::kernels::{self, dot};
@@ -9,7 +10,7 @@ use nalgebra::DMatrix;
 pub(super) struct Path {
     pub(super) alphas: Vec<f64>,
     /// knot after knot, `p` coefficients each
-    pub(super) coefs: Vec<f64>,
+    pub(super) coefs: Knots,
     pub(super) events: Vec<PathEvent>,
     pub(super) active: Vec<usize>,
     pub(super) stop: StopReason,
@@ -20,15 +21,17 @@ pub(super) struct Core<'a> {
     xs: &'a DMatrix<f64>,
     n: usize,
     p: usize,
-    /// `X^T X` (column-major p x p), when precomputed.
+    /// `X^T X` (column-major p x p, column stride `ld`), when precomputed.
     gram: Option<Vec<f64>>,
+    ld: usize,
     /// `X^T y`, computed with the Gram matrix.
     xty: Option<Vec<f64>>,
     /// `||x_j||^2`.
     sq_norms: Vec<f64>,
-    /// Scratch without the Gram matrix: the equiangular vector `u = X_A w` (length n), the
-    /// eligible inactive columns and their `a_j`.
+    /// Scratch without the Gram matrix: the equiangular vector `u = X_A w` (length n).
     u: Vec<f64>,
+    /// The eligible inactive columns, in increasing order (kept up to date by `run`), and
+    /// their `a_j`.
     inactive: Vec<usize>,
     a_inactive: Vec<f64>,
     /// With the Gram matrix: `G[gc_rows, :]` (column-major), a superset of the inactive
@@ -42,14 +45,14 @@ impl<'a> Core<'a> {
     /// With `use_gram`, `X^T X` and `X^T ys` are computed here, in one pass over `X`.
     pub(super) fn new(xs: &'a DMatrix<f64>, ys: &[f64], use_gram: bool) -> Self {
         let (n, p) = xs.shape();
-        let (gram, xty) = if use_gram {
-            let (g, xty) = kernels::gram(xs.as_slice(), n, p, ys);
-            (Some(g), Some(xty))
+        let (gram, ld, xty) = if use_gram {
+            let (g, ld, xty) = kernels::gram(xs.as_slice(), n, p, ys);
+            (Some(g), ld, Some(xty))
         } else {
-            (None, None)
+            (None, p, None)
         };
         let sq_norms = match &gram {
-            Some(g) => (0..p).map(|j| g[j * p + j]).collect(),
+            Some(g) => (0..p).map(|j| g[j * ld + j]).collect(),
             None => (0..p)
                 .map(|j| {
                     let c = &xs.as_slice()[j * n..(j + 1) * n];
@@ -62,6 +65,7 @@ impl<'a> Core<'a> {
             n,
             p,
             gram,
+            ld,
             xty,
             sq_norms,
             u: vec![0.0; if use_gram { 0 } else { n }],
@@ -81,7 +85,7 @@ impl<'a> Core<'a> {
     fn gram_with_active(&self, active: &[usize], j: usize, out: &mut Vec<f64>) {
         out.clear();
         match &self.gram {
-            Some(g) => out.extend(active.iter().map(|&a| g[j * self.p + a])),
+            Some(g) => out.extend(active.iter().map(|&a| g[j * self.ld + a])),
             None => {
                 out.resize(active.len(), 0.0);
                 kernels::dots(self.xs.as_slice(), self.n, active, self.col(j), out);
@@ -89,8 +93,9 @@ impl<'a> Core<'a> {
         }
     }
 
-    /// `a = X^T X_A w` for the eligible inactive columns (from the Gram matrix's rows of
-    /// those columns, or from `u = X_A w`), and `a_j = aa s_j` (eq. 2.6) on the active set.
+    /// `a = X^T X_A w` for the eligible inactive columns (`self.inactive`; from the Gram
+    /// matrix's rows of those columns, or from `u = X_A w`), and `a_j = aa s_j` (eq. 2.6) on
+    /// the active set.
     #[allow(clippy::too_many_arguments)]
     fn equiangular_correlations(
         &mut self,
@@ -98,17 +103,14 @@ impl<'a> Core<'a> {
         w: &[f64],
         signs: &[f64],
         aa: f64,
-        usable: impl Fn(usize) -> bool,
         a: &mut [f64],
     ) {
-        self.inactive.clear();
-        self.inactive.extend((0..self.p).filter(|&j| usable(j)));
         match &self.gram {
             Some(g) => {
                 // rows of G for the inactive columns only (sklearn keeps them apart by
                 // swapping rows of G): a compacted copy, rebuilt when a quarter of its rows
                 // has become active or a dropped column needs a row it lacks
-                let p = self.p;
+                let (p, ld) = (self.p, self.ld);
                 let stale = self.inactive.len() * 4 < self.gc_rows.len() * 3
                     || self.inactive.iter().any(|&j| !self.in_gc[j]);
                 if stale {
@@ -120,7 +122,7 @@ impl<'a> Core<'a> {
                     let m = self.gc_rows.len();
                     self.gc.resize(m * p, 0.0);
                     for (k, gk) in self.gc.chunks_exact_mut(m.max(1)).enumerate().take(p) {
-                        let src = &g[k * p..(k + 1) * p];
+                        let src = &g[k * ld..k * ld + p];
                         for (dst, &j) in gk.iter_mut().zip(&self.gc_rows) {
                             *dst = src[j];
                         }
@@ -207,21 +209,23 @@ impl<'a> Core<'a> {
                 c[j] = v;
             }
         }
-        let c0 = (0..p)
-            .filter(|&j| eligible[j])
-            .map(|j| c[j].abs())
+        self.inactive.clear();
+        self.inactive.extend((0..p).filter(|&j| eligible[j]));
+        let c0 = self
+            .inactive
+            .iter()
+            .map(|&j| c[j].abs())
             .fold(0.0, f64::max);
 
         let mut beta = vec![0.0; p];
         let mut alphas = vec![c0 / nf];
         // room for the knots of a full LAR path (the lasso may need more), within reason
         let knots_guess = self.n.min(p).min(params.max_steps.unwrap_or(usize::MAX)) + 2;
-        let mut coefs = Vec::with_capacity(p.saturating_mul(knots_guess).min(1 << 24));
-        coefs.extend_from_slice(&beta);
+        let mut coefs = Knots::with_capacity(p, knots_guess.min((1 << 24) / p.max(1)));
+        coefs.push(&beta);
         let mut events = Vec::new();
         let mut active: Vec<usize> = Vec::new();
         let mut signs: Vec<f64> = Vec::new();
-        let mut is_active = vec![false; p];
         let mut chol = CholeskyFactor::default();
         // z = L^{-1} s, extended on each entry, recomputed after drops (the downdate changes L)
         let mut z: Vec<f64> = Vec::new();
@@ -230,6 +234,9 @@ impl<'a> Core<'a> {
         let mut big_c = c0;
         let mut step = 0usize;
         let mut scratch = Vec::new();
+        let mut candidates: Vec<usize> = Vec::new();
+        let mut w: Vec<f64> = Vec::new();
+        let mut drops: Vec<usize> = Vec::new(); // positions in `active`
         let mut a = vec![0.0; p];
 
         let finish = |alphas, coefs, events, active, stop, chol| Path {
@@ -275,34 +282,34 @@ impl<'a> Core<'a> {
 
             // --- variables that tie for the largest correlation enter -------------------------
             let threshold = big_c * (1.0 - params.tie_tolerance);
-            let mut candidates: Vec<usize> = (0..p)
-                .filter(|&j| {
-                    eligible[j]
-                        && !is_active[j]
-                        && !just_dropped.contains(&j)
-                        && c[j].abs() >= threshold
-                })
-                .collect();
+            candidates.clear();
+            candidates.extend(
+                self.inactive
+                    .iter()
+                    .copied()
+                    .filter(|&j| c[j].abs() >= threshold && !just_dropped.contains(&j)),
+            );
             candidates.sort_by(|&i, &j| c[j].abs().total_cmp(&c[i].abs()).then(i.cmp(&j)));
             if z_stale {
                 z.clone_from(&signs);
                 chol.forward_in_place(&mut z);
                 z_stale = false;
             }
-            for j in candidates {
+            for &j in &candidates {
                 self.gram_with_active(&active, j, &mut scratch);
                 match chol.append(&scratch, self.sq_norms[j], params.collinearity_tolerance) {
                     Append::Appended => {
+                        remove_sorted(&mut self.inactive, j);
                         active.push(j);
                         let sj = if c[j] >= 0.0 { 1.0 } else { -1.0 };
                         signs.push(sj);
                         // the factor grew by one row: z = L^{-1} s grows by one entry, the
                         // same value a full forward solve would give
                         chol.forward_extend(&mut z, sj);
-                        is_active[j] = true;
                         events.push(PathEvent::Added { feature: j, step });
                     }
                     Append::Collinear => {
+                        remove_sorted(&mut self.inactive, j);
                         eligible[j] = false;
                         excluded.push(Exclusion {
                             feature: j,
@@ -325,7 +332,7 @@ impl<'a> Core<'a> {
             }
 
             // --- equiangular direction: w = AA G_AA^{-1} s ---------------------------------
-            let mut w = z.clone();
+            w.clone_from(&z);
             chol.backward_in_place(&mut w);
             let q: f64 = w.iter().zip(&signs).map(|(wi, si)| wi * si).sum();
             if !(q.is_finite() && q > 0.0) {
@@ -340,14 +347,7 @@ impl<'a> Core<'a> {
             }
             let aa = 1.0 / q.sqrt();
             w.iter_mut().for_each(|v| *v *= aa);
-            self.equiangular_correlations(
-                &active,
-                &w,
-                &signs,
-                aa,
-                |j| eligible[j] && !is_active[j],
-                &mut a,
-            );
+            self.equiangular_correlations(&active, &w, &signs, aa, &mut a);
 
             // --- step length --------------------------------------------------------------
             let gamma_hat = big_c / aa;
@@ -364,8 +364,10 @@ impl<'a> Core<'a> {
                     let num = big_c - side * c[j];
                     let den = aa - side * a[j];
                     // the division only when it may shorten the step: num / den < gamma
-                    // implies num < gamma den (1 + 4 eps) whatever the rounding
-                    if num > 0.0 && den > 0.0 && num < gamma * den * (1.0 + 4.0 * f64::EPSILON) {
+                    // implies num < gamma den (1 + 4 eps) whatever the rounding (`&`, not
+                    // `&&`: one rarely taken branch instead of three unpredictable ones)
+                    if (num > 0.0) & (den > 0.0) & (num < gamma * den * (1.0 + 4.0 * f64::EPSILON))
+                    {
                         let g = num / den;
                         if g < gamma {
                             gamma = g;
@@ -374,7 +376,7 @@ impl<'a> Core<'a> {
                 }
             }
             // lasso: the first active coefficient to reach zero
-            let mut drops: Vec<usize> = Vec::new(); // positions in `active`
+            drops.clear();
             if params.method == Method::Lasso {
                 let mut z_min = f64::INFINITY;
                 for (pos, &j) in active.iter().enumerate() {
@@ -418,7 +420,7 @@ impl<'a> Core<'a> {
                 signs.remove(pos);
                 chol.remove(pos);
                 z_stale = true;
-                is_active[j] = false;
+                insert_sorted(&mut self.inactive, j);
                 beta[j] = 0.0;
                 just_dropped.push(j);
                 events.push(PathEvent::Dropped { feature: j, step });
@@ -427,7 +429,7 @@ impl<'a> Core<'a> {
             let alpha = big_c / nf;
             let prev_alpha = alphas[alphas.len() - 1];
             if params.alpha_min > 0.0 && alpha <= params.alpha_min {
-                let prev = &coefs[coefs.len() - p..];
+                let prev = coefs.knot(coefs.len() - 1);
                 let ss = if prev_alpha > alpha {
                     (prev_alpha - params.alpha_min) / (prev_alpha - alpha)
                 } else {
@@ -439,11 +441,11 @@ impl<'a> Core<'a> {
                     .map(|(b0, b1)| b0 + ss * (b1 - b0))
                     .collect();
                 alphas.push(params.alpha_min);
-                coefs.extend_from_slice(&knot);
+                coefs.push(&knot);
                 return finish(alphas, coefs, events, active, StopReason::AlphaMin, chol);
             }
             alphas.push(alpha);
-            coefs.extend_from_slice(&beta);
+            coefs.push(&beta);
             if full_step {
                 let stop = if any_inactive {
                     StopReason::CorrelationVanished
@@ -453,5 +455,19 @@ impl<'a> Core<'a> {
                 return finish(alphas, coefs, events, active, stop, chol);
             }
         }
+    }
+}
+
+/// Removes `j` from the increasing list `list` (if present).
+fn remove_sorted(list: &mut Vec<usize>, j: usize) {
+    if let Ok(pos) = list.binary_search(&j) {
+        list.remove(pos);
+    }
+}
+
+/// Inserts `j` into the increasing list `list` (if absent).
+fn insert_sorted(list: &mut Vec<usize>, j: usize) {
+    if let Err(pos) = list.binary_search(&j) {
+        list.insert(pos, j);
     }
 }
