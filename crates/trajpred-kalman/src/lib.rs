@@ -40,6 +40,7 @@ pub use motion::{CoordinatedTurn, RangeBearing, StateOrder};
 pub mod ikf;
 pub mod imm;
 pub mod predictor;
+pub mod turn_accel;
 pub use ikf::{Ikf, IkfStep, Innovation};
 pub use imm::{Imm, ImmState, ImmStep, TimedImm};
 pub use predictor::MultiStep;

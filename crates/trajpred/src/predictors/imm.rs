@@ -1,13 +1,14 @@
-//! The interacting multiple model filter over actual time ("imm"): a constant-velocity mode
-//! and a coordinated-turn mode (EKF) on the state `[x, vx, y, vy, omega]`, switching at
-//! random ([`trajpred_kalman::imm::uniform_switching`]); the noise of both modes follows each
+//! The interacting multiple model filter over actual time ("imm"): constant-velocity,
+//! coordinated-turn (EKF) and constant-acceleration modes on the state
+//! `[x, vx, y, vy, omega, ax, ay]` ([`trajpred_kalman::turn_accel`]), switching at random
+//! ([`trajpred_kalman::imm::uniform_switching`]); the noise of every mode follows each
 //! interval of the track (continuous white noise, as in [`KfTime`]). Run through the filter
 //! driver ([`trajpred_kalman::driver`]); forecasts at any future times with the mixture's
 //! mean and covariance. 2-D tracks only (the turn acts in the plane).
 //!
 //! Fitting, on the training tracks: the acceleration density `q` and observation variance
-//! `r` are [`KfTime`]'s maximum-likelihood fit of the constant-velocity model; then the
-//! turn-rate density and the mean sojourn time in a mode maximise the IMM's own likelihood
+//! `r` are [`KfTime`]'s maximum-likelihood fit of the constant-velocity model, the jerk
+//! density its fit of the constant-acceleration model; then the turn-rate density and the mean sojourn time in a mode maximise the IMM's own likelihood
 //! (the same grid search). See `docs/kalman.md`, section "IMM".
 
 use super::fitted::{At, exact};
@@ -15,14 +16,16 @@ use super::{
     forecast_times_on_mean_interval, invalid, kf_time::maximise, offsets_after, positions_forecast,
 };
 use crate::predictors::{KfTime, KfTimeParams};
-use nalgebra::{Matrix5, U2, U5, Vector2, Vector5};
+use nalgebra::{SMatrix, SVector, U2, U7, Vector2};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use trajpred_core::{Error, Forecast, Gaussian, Predictor, Result, Trajectory};
 use trajpred_kalman::driver::{TimeStepFilter, drive};
 use trajpred_kalman::imm::{
-    Imm, ImmState, TimedImm, constant_velocity_in_turn_state, coordinated_turn_continuous,
-    turn_state_position_observation, uniform_switching,
+    Imm, ImmState, TimedImm, coordinated_turn_continuous, uniform_switching,
+};
+use trajpred_kalman::turn_accel::{
+    TurnWithAcceleration, constant_acceleration, constant_velocity, position_observation,
 };
 use trajpred_kalman::{Ekf, Filter, KalmanError, Kf};
 
@@ -35,6 +38,9 @@ pub struct ImmParams {
     pub r: f64,
     /// Spectral density of the turn rate's random walk in the turn mode (rad^2/s^3); fitted.
     pub turn_rate_density: f64,
+    /// Spectral density of the white jerk of the constant-acceleration mode (m^2/s^5);
+    /// fitted.
+    pub jerk_density: f64,
     /// Mean time spent in a mode before switching (s); fitted.
     pub mean_sojourn: f64,
     /// Variance of the initial velocity components (m^2/s^2).
@@ -56,6 +62,7 @@ impl Default for ImmParams {
             spectral_density: 1.0,
             r: 10.0,
             turn_rate_density: 1e-3,
+            jerk_density: 0.1,
             mean_sojourn: 20.0,
             initial_rate_variance: 100.0,
             initial_turn_rate_variance: 0.01,
@@ -72,6 +79,7 @@ impl ImmParams {
             ("spectral_density", self.spectral_density),
             ("r", self.r),
             ("turn_rate_density", self.turn_rate_density),
+            ("jerk_density", self.jerk_density),
             ("mean_sojourn", self.mean_sojourn),
             ("initial_rate_variance", self.initial_rate_variance),
             (
@@ -119,7 +127,7 @@ pub struct ImmPredictor {
     params: ImmParams,
 }
 
-type Mode = Box<dyn Filter<f64, U5, U2>>;
+type Mode = Box<dyn Filter<f64, U7, U2>>;
 
 fn kalman(e: KalmanError) -> Error {
     Error::from_crate("imm", e)
@@ -127,20 +135,22 @@ fn kalman(e: KalmanError) -> Error {
 
 /// The IMM for a step of `dt` seconds under `p`.
 fn build(p: ImmParams, dt: f64) -> trajpred_kalman::Result<Imm<f64, Mode>> {
-    let obs = turn_state_position_observation::<f64>(p.r)?;
+    let obs = position_observation::<f64>(p.r)?;
     let cv = Kf::new(
-        constant_velocity_in_turn_state::<f64>(dt, p.spectral_density)?,
+        constant_velocity::<f64>(dt, p.spectral_density)?,
         obs.clone(),
     )?;
-    let ct = Ekf::new(
-        coordinated_turn_continuous::<f64>(dt, p.spectral_density, p.turn_rate_density)?,
-        obs,
-    )?;
-    let modes: Vec<Mode> = vec![Box::new(cv), Box::new(ct)];
-    Imm::new(modes, uniform_switching(2, dt, p.mean_sojourn)?)
+    let turn = coordinated_turn_continuous::<f64>(dt, p.spectral_density, p.turn_rate_density)?;
+    let ct = Ekf::new(TurnWithAcceleration::new(turn), obs.clone())?;
+    let ca = Kf::new(constant_acceleration::<f64>(dt, p.jerk_density)?, obs)?;
+    let modes: Vec<Mode> = vec![Box::new(cv), Box::new(ct), Box::new(ca)];
+    Imm::new(modes, uniform_switching(MODES, dt, p.mean_sojourn)?)
 }
 
-type Run = TimedImm<f64, U5, Mode, Box<dyn Fn(f64) -> trajpred_kalman::Result<Imm<f64, Mode>>>>;
+/// The modes: constant velocity, coordinated turn, constant acceleration.
+const MODES: usize = 3;
+
+type Run = TimedImm<f64, U7, Mode, Box<dyn Fn(f64) -> trajpred_kalman::Result<Imm<f64, Mode>>>>;
 
 impl ImmPredictor {
     /// A validated predictor.
@@ -166,19 +176,22 @@ impl ImmPredictor {
             ));
         }
         let first = history.point(0);
+        let v = p.initial_rate_variance;
         let start = Gaussian::new(
-            Vector5::new(first[0], 0.0, first[1], 0.0, 0.0),
-            Matrix5::from_diagonal(&Vector5::new(
+            SVector::<f64, 7>::from_column_slice(&[first[0], 0.0, first[1], 0.0, 0.0, 0.0, 0.0]),
+            SMatrix::<f64, 7, 7>::from_diagonal(&SVector::<f64, 7>::from_column_slice(&[
                 p.r,
-                p.initial_rate_variance,
+                v,
                 p.r,
-                p.initial_rate_variance,
+                v,
                 p.initial_turn_rate_variance,
-            )),
+                v,
+                v,
+            ])),
         )?;
         let make: Box<dyn Fn(f64) -> trajpred_kalman::Result<Imm<f64, Mode>>> =
             Box::new(move |dt| build(p, dt));
-        let mut f = TimedImm::new(make, ImmState::uniform(start, 2).map_err(kalman)?);
+        let mut f = TimedImm::new(make, ImmState::uniform(start, MODES).map_err(kalman)?);
         let z: Vec<Option<Vector2<f64>>> = (0..history.len())
             .map(|k| {
                 let q = history.point(k);
@@ -216,6 +229,14 @@ impl Predictor for ImmPredictor {
         kf.fit(train)?;
         let mut p = self.params;
         (p.spectral_density, p.r) = (kf.params().spectral_density, kf.params().r);
+        let mut ca = KfTime::new(KfTimeParams {
+            derivatives: 3,
+            fit_tracks: self.params.fit_tracks,
+            fit_points: self.params.fit_points,
+            ..Default::default()
+        })?;
+        ca.fit(train)?;
+        p.jerk_density = ca.params().spectral_density;
         let usable: Vec<&Trajectory> = train.iter().filter(|t| t.len() >= 3).collect();
         let step = usable.len().div_ceil(self.params.fit_tracks / 4).max(1);
         let tracks: Vec<Trajectory> = usable
@@ -266,30 +287,33 @@ impl Predictor for ImmPredictor {
         positions_forecast(&states, 2)
     }
 
-    /// The four fitted settings `{"spectral_density", "r", "turn_rate_density",
-    /// "mean_sojourn"}` (fitted, or as given when `fit_noise` is off).
+    /// The five fitted settings `{"spectral_density", "r", "turn_rate_density",
+    /// "jerk_density", "mean_sojourn"}` (fitted, or as given when `fit_noise` is off).
     fn fitted_params(&self) -> Result<serde_json::Value> {
         let p = &self.params;
         Ok(serde_json::json!({
             "spectral_density": exact(p.spectral_density),
             "r": exact(p.r),
             "turn_rate_density": exact(p.turn_rate_density),
+            "jerk_density": exact(p.jerk_density),
             "mean_sojourn": exact(p.mean_sojourn),
         }))
     }
 
     fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
         let name = self.name().to_string();
-        let [q, r, turn, sojourn] = At::root(&name, params).fields([
+        let [q, r, turn, jerk, sojourn] = At::root(&name, params).fields([
             "spectral_density",
             "r",
             "turn_rate_density",
+            "jerk_density",
             "mean_sojourn",
         ])?;
         self.params = ImmParams {
             spectral_density: q.f64_min(0.0, true)?,
             r: r.f64_min(0.0, true)?,
             turn_rate_density: turn.f64_min(0.0, true)?,
+            jerk_density: jerk.f64_min(0.0, true)?,
             mean_sojourn: sojourn.f64_min(0.0, true)?,
             ..self.params
         };
@@ -299,8 +323,8 @@ impl Predictor for ImmPredictor {
     fn fitted_summary(&self) -> Option<String> {
         let p = &self.params;
         Some(format!(
-            "q = {:.3e} m^2/s^3, r = {:.3e} m^2, turn-rate density {:.3e} rad^2/s^3, mean sojourn {:.3e} s",
-            p.spectral_density, p.r, p.turn_rate_density, p.mean_sojourn
+            "q = {:.3e} m^2/s^3, r = {:.3e} m^2, turn-rate density {:.3e} rad^2/s^3, jerk density {:.3e} m^2/s^5, mean sojourn {:.3e} s",
+            p.spectral_density, p.r, p.turn_rate_density, p.jerk_density, p.mean_sojourn
         ))
     }
 }
