@@ -264,6 +264,10 @@ pub struct Claim {
     pub holds: bool,
     /// The numbers of this run that decide it.
     pub evidence: String,
+    /// Decided by this machine's wall times: `--check` compares that the claim is there, not
+    /// its verdict, which can change with the machine's load.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub wall_time: bool,
 }
 
 /// Everything one paper's runner produced.
@@ -297,18 +301,22 @@ impl PaperResult {
         }
     }
 
-    /// Records a claim, deciding it by `holds`.
+    /// Records a claim, deciding it by `holds`, and returns it (to mark it
+    /// [`wall_time`](Claim::wall_time)).
     pub fn claim(
         &mut self,
         statement: impl Into<String>,
         holds: bool,
         evidence: impl Into<String>,
-    ) {
+    ) -> &mut Claim {
         self.claims.push(Claim {
             statement: statement.into(),
             holds,
             evidence: evidence.into(),
+            wall_time: false,
         });
+        let last = self.claims.len() - 1;
+        &mut self.claims[last]
     }
 }
 

@@ -355,11 +355,13 @@ pub fn assemble(spec: &Spec, ctx: &Context, computed: Computed) -> Result<PaperR
             continue;
         };
         let err = |reason: String| spec_err(spec, format!("claim {}: {reason}", c.id));
-        result.claim(
-            render(&c.statement, &env).map_err(err)?,
-            holds,
-            render(&c.evidence, &env).map_err(err)?,
-        );
+        result
+            .claim(
+                render(&c.statement, &env).map_err(err)?,
+                holds,
+                render(&c.evidence, &env).map_err(err)?,
+            )
+            .wall_time = c.wall_time;
     }
     result.notes = computed.notes.clone();
     for n in &spec.notes {

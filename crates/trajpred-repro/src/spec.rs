@@ -237,6 +237,9 @@ pub struct ClaimSpec {
     /// Not checked when any of these tables is in the run.
     #[serde(default)]
     pub unless: Vec<String>,
+    /// Decided by wall times of this machine: `--check` does not compare its verdict.
+    #[serde(default)]
+    pub wall_time: bool,
 }
 
 /// A section after instance expansion.

@@ -195,8 +195,9 @@ pub fn compare_with_committed(tables: &[Table], dir: &Path) -> Result<Vec<Differ
 /// Compares a whole fresh run with the run committed in `dir` (a paper's folder): its tables
 /// as [`compare_with_committed`] does, then its figures and claims against the committed
 /// `run.json` (a figure or claim on one side only is a difference, and so is a claim that
-/// holds in one run and not in the other; claims are matched by statement, their evidence is
-/// not compared). Titles, notes and wall times are not compared.
+/// holds in one run and not in the other, unless the fresh claim is decided by wall times;
+/// claims are matched by statement, their evidence is not compared). Titles, notes and wall
+/// times are not compared.
 pub fn compare_run(result: &PaperResult, dir: &Path) -> Result<Vec<Difference>> {
     let mut diffs = compare_with_committed(&result.tables, dir)?;
     if matches!(diffs.as_slice(), [Difference::NoCommittedRun { .. }]) {
@@ -226,7 +227,7 @@ pub fn compare_run(result: &PaperResult, dir: &Path) -> Result<Vec<Difference>> 
         match unmatched.iter().position(|f| f.statement == c.statement) {
             Some(i) => {
                 let f = unmatched.remove(i);
-                if f.holds != c.holds {
+                if f.holds != c.holds && !f.wall_time {
                     diffs.push(Difference::Verdict {
                         statement: c.statement.clone(),
                         committed: c.holds,

@@ -72,6 +72,7 @@ impl Spec {
                         evidence: sub(&c.evidence)?,
                         only: None,
                         unless: c.unless.iter().map(|u| sub(u)).collect::<Result<_>>()?,
+                        wall_time: c.wall_time,
                     });
                 }
                 let quantities = section
