@@ -83,6 +83,18 @@ fn a_forecast_is_the_weighted_mean_of_the_members_forecasts() {
     let history = whole.prefix(30).expect("prefix");
     let times = &whole.times()[30..33];
     let got = b.forecast_times(&history, times).expect("forecast");
+    // the regime: how many edges the last two fixes' speed exceeds
+    let n = history.len();
+    let (p, q) = (history.point(n - 1), history.point(n - 2));
+    let dist = p
+        .as_ref()
+        .iter()
+        .zip(q.as_ref())
+        .map(|(a, b)| (a - b).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    let speed = dist / (history.times()[n - 1] - history.times()[n - 2]);
+    let regime = b.speed_edges().iter().filter(|&&e| speed > e).count();
     let mut want = [[0.0; 2]; 3];
     let mut total = [0.0; 3];
     for m in members {
@@ -91,7 +103,7 @@ fn a_forecast_is_the_weighted_mean_of_the_members_forecasts() {
         p.load_fitted_params(&m["params"]).expect("loads");
         let f = p.forecast_times(&history, times).expect("member forecast");
         for k in 0..3 {
-            let w: f64 = m["weights"][k]
+            let w: f64 = m["weights"][regime][k]
                 .as_str()
                 .expect("exact")
                 .parse()
@@ -117,19 +129,23 @@ fn a_forecast_is_the_weighted_mean_of_the_members_forecasts() {
     loaded.load_fitted_params(&saved).expect("loads");
     let again = loaded.forecast_times(&history, times).expect("forecast");
     assert_eq!(format!("{got:?}"), format!("{again:?}"));
-    assert!(b.fitted_summary().expect("summary").contains("held out"));
+    assert!(b.fitted_summary().expect("summary").contains("held-out"));
 }
 
-/// Worked by hand: a quarter of the last velocity's forecast and three quarters of the last
-/// position's at step 1, the other way round at step 2.
+/// Worked by hand: two speed regimes split at 1.5 m/s. Above it, a quarter of the last
+/// velocity's forecast and three quarters of the last position's at step 1, the other way
+/// round at step 2; below it, the last velocity alone at step 1, the last position alone
+/// at step 2.
 #[test]
 fn a_saved_blend_forecasts_its_hand_computed_mean() {
     let mut b = blend();
-    b.load_fitted_params(&json!({"members": [
-        {"method": "cv-time", "weights": ["0.25", "0.75"], "params": null},
-        {"method": "last-position", "weights": ["0.75", "0.25"], "params": null},
+    b.load_fitted_params(&json!({"speed_edges": ["1.5"], "members": [
+        {"method": "cv-time", "weights": [["1", "0"], ["0.25", "0.75"]], "params": null},
+        {"method": "last-position", "weights": [["0", "1"], ["0.75", "0.25"]], "params": null},
     ]}))
     .expect("loads");
+    assert_eq!(b.speed_edges(), &[1.5]);
+    assert_eq!(b.weights("cv-time", 1), Some(&[0.25, 0.75][..]));
     // last fix (4, 2) at t = 2 after (2, 2) at t = 1: 2 m/s along x
     let h = Trajectory::from_axes(vec![0.0, 1.0, 2.0], vec![vec![0.0, 2.0, 4.0], vec![2.0; 3]])
         .expect("valid");
@@ -138,6 +154,13 @@ fn a_saved_blend_forecasts_its_hand_computed_mean() {
     assert_eq!(f.step(1), &[0.25 * 6.0 + 0.75 * 4.0, 2.0]);
     assert_eq!(f.step(2), &[0.75 * 8.0 + 0.25 * 4.0, 2.0]);
     assert_eq!(f.step(3), &[0.75 * 12.0 + 0.25 * 4.0, 2.0]);
+    // last fix (2, 2) at t = 2 after (1, 2) at t = 1: 1 m/s, the slow regime
+    let h = Trajectory::from_axes(vec![0.0, 1.0, 2.0], vec![vec![0.0, 1.0, 2.0], vec![2.0; 3]])
+        .expect("valid");
+    let f = b.forecast_times(&h, &[3.0, 4.0, 6.0]).expect("forecast");
+    assert_eq!(f.step(1), &[3.0, 2.0]);
+    assert_eq!(f.step(2), &[2.0, 2.0]);
+    assert_eq!(f.step(3), &[2.0, 2.0]);
 }
 
 #[test]
@@ -166,21 +189,35 @@ fn bad_saved_blends_are_typed_errors_at_their_path() {
         "not among",
     );
     check(
-        &|v| v["members"][0]["weights"][0] = json!("-0.5"),
-        "members[0].weights[0]",
+        &|v| v["members"][0]["weights"][0][0] = json!("-0.5"),
+        "members[0].weights[0][0]",
         ">= 0",
     );
     check(
         &|v| {
-            let w = v["members"][0]["weights"][1]
+            let w = v["members"][0]["weights"][0][1]
                 .as_str()
                 .unwrap()
                 .parse::<f64>()
                 .unwrap();
-            v["members"][0]["weights"][1] = json!(format!("{:?}", w + 0.25));
+            v["members"][0]["weights"][0][1] = json!(format!("{:?}", w + 0.25));
         },
         "members",
-        "step 2",
+        "regime 0, step 2",
+    );
+    // edges must increase, and each member needs one weight list per regime
+    check(
+        &|v| v["speed_edges"] = json!(["2", "1"]),
+        "speed_edges[1]",
+        "must exceed",
+    );
+    check(
+        &|v| {
+            let regimes = v["members"][0]["weights"].as_array().unwrap().len();
+            v["speed_edges"] = json!((0..regimes).map(|i| format!("{i}")).collect::<Vec<_>>());
+        },
+        "members[0].weights",
+        "entries",
     );
     check(
         &|v| {
@@ -228,6 +265,7 @@ fn bad_settings_and_unfitted_use_are_typed_errors() {
         ),
         (&|p: &mut BlendParams| p.folds = 1, "folds"),
         (&|p: &mut BlendParams| p.rounds = 0, "rounds"),
+        (&|p: &mut BlendParams| p.max_regimes = 0, "max_regimes"),
     ] {
         match with(edit) {
             Err(Error::InvalidParameter { name: n, .. }) => assert_eq!(n, name),

@@ -4,6 +4,9 @@
 use super::auto::{DEFAULT_CANDIDATES, fold_of_trajectories, fold_split, load_member};
 use super::fitted::{At, exact_vec};
 use super::invalid;
+use held_out::{HeldOut, quantile_edges, regime_of, speed_at};
+
+mod held_out;
 use crate::harness::{self, EvalConfig, ForecastPair};
 use crate::registry::{self, MethodOptions};
 use serde::{Deserialize, Serialize};
@@ -12,6 +15,9 @@ use trajpred_core::{Error, Forecast, Point, Predictor, Result, Trajectory};
 
 /// The most forecast steps a saved blend may hold weights for.
 const MAX_STEPS: usize = 10_000;
+
+/// The most speed regimes a saved blend may hold.
+const MAX_REGIMES: usize = 1_000;
 
 /// Parameters of [`Blend`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -25,6 +31,10 @@ pub struct BlendParams {
     /// Rounds of the greedy selection per step: each round adds one copy of one candidate,
     /// so a weight is a multiple of `1 / rounds` at finest.
     pub rounds: usize,
+    /// The most speed regimes: the held-out origins are split at quantiles of the last
+    /// observed speed into 1 to `max_regimes` regimes, each with its own weights, and the
+    /// number is chosen by cross-validation over the held-out folds (1 is the plain blend).
+    pub max_regimes: usize,
     /// The rolling origin the held-out forecasts are made on (the run's own settings).
     pub eval: EvalConfig,
 }
@@ -36,97 +46,19 @@ impl Default for BlendParams {
             folds: 5,
             seed: 0,
             rounds: 20,
+            max_regimes: 4,
             eval: EvalConfig::default(),
         }
     }
 }
 
-/// A member of a fitted blend: a method fitted on all the training data and its weight at
-/// each forecast step.
+/// A member of a fitted blend: a method fitted on all the training data and its weight in
+/// each speed regime at each forecast step.
 struct Member {
     name: String,
     predictor: Box<dyn Predictor>,
-    weights: Vec<f64>,
-}
-
-/// The held-out forecasts of every candidate on the same origins, and the truth.
-struct HeldOut {
-    horizon: usize,
-    dim: usize,
-    /// `truth[(i * horizon + k) * dim + a]`
-    truth: Vec<f64>,
-    /// One per usable candidate: its index among the candidates and its forecasts, laid out
-    /// like `truth`.
-    forecasts: Vec<(usize, Vec<f64>)>,
-}
-
-impl HeldOut {
-    fn origins(&self) -> usize {
-        self.truth.len() / (self.horizon * self.dim)
-    }
-
-    /// Mean error at step `k` of the forecast `sum / m` (`sum` laid out as one step of
-    /// `truth`, per origin).
-    fn error(&self, k: usize, sum: &[f64], m: f64) -> f64 {
-        let (h, d) = (self.horizon, self.dim);
-        let n = self.origins();
-        let mut total = 0.0;
-        for i in 0..n {
-            let t = &self.truth[(i * h + k) * d..][..d];
-            let s = &sum[i * d..][..d];
-            total += t
-                .iter()
-                .zip(s)
-                .map(|(t, s)| (s / m - t).powi(2))
-                .sum::<f64>()
-                .sqrt();
-        }
-        total / n as f64
-    }
-
-    /// Greedy selection with replacement at step `k` (Caruana et al., 2004): each round adds
-    /// the candidate whose copy lowers the held-out mean error most; the counts of the best
-    /// round are kept. Returns the counts per usable candidate, the rounds they sum to and
-    /// the error.
-    fn select(&self, k: usize, rounds: usize) -> (Vec<usize>, usize, f64) {
-        let (h, d, n) = (self.horizon, self.dim, self.origins());
-        let step = |f: &[f64], i: usize| -> [f64; 3] {
-            let mut p = [0.0; 3];
-            p[..d].copy_from_slice(&f[(i * h + k) * d..][..d]);
-            p
-        };
-        let mut sum = vec![0.0; n * d];
-        let mut counts = vec![0usize; self.forecasts.len()];
-        let mut best = (counts.clone(), 0usize, f64::INFINITY);
-        let mut trial = vec![0.0; n * d];
-        for round in 1..=rounds {
-            let mut pick = None::<(usize, f64)>;
-            for (c, (_, f)) in self.forecasts.iter().enumerate() {
-                for i in 0..n {
-                    let p = step(f, i);
-                    for a in 0..d {
-                        trial[i * d + a] = sum[i * d + a] + p[a];
-                    }
-                }
-                let e = self.error(k, &trial, round as f64);
-                if pick.is_none_or(|(_, b)| e < b) {
-                    pick = Some((c, e));
-                }
-            }
-            let Some((c, e)) = pick else { break };
-            counts[c] += 1;
-            for i in 0..n {
-                let p = step(&self.forecasts[c].1, i);
-                for a in 0..d {
-                    sum[i * d + a] += p[a];
-                }
-            }
-            if e < best.2 {
-                best = (counts.clone(), round, e);
-            }
-        }
-        best
-    }
+    /// `weights[r][k]`: the weight in regime `r` at step `k`.
+    weights: Vec<Vec<f64>>,
 }
 
 /// Blends candidate methods: at each forecast step, a weighted mean of their forecasts
@@ -141,7 +73,12 @@ impl HeldOut {
 /// [`BlendParams::rounds`] rounds adds the candidate that most lowers the mean Euclidean
 /// error of the averaged held-out forecasts at step `k`, and the best round's counts, divided
 /// by their sum, are the weights. One round is the single best candidate, so a blend is at
-/// worst `auto`'s choice per step on the held-out folds. A candidate that fails to fit or
+/// worst `auto`'s choice per step on the held-out folds. The weights may differ with the
+/// speed of the target: the origins are split into speed regimes at quantiles of their last
+/// observed speed (the distance between the last two fixes over their time apart), each
+/// regime with its own weights, and the number of regimes (1 to
+/// [`BlendParams::max_regimes`]) is the one whose weights, chosen on all held-out folds but
+/// one, score best on the remaining fold, over every fold. A candidate that fails to fit or
 /// refuses a held-out forecast is left out. The members with a weight are refitted on all
 /// the training data.
 ///
@@ -165,13 +102,17 @@ impl HeldOut {
 /// };
 /// let mut blend = Blend::new(params, MethodOptions::default())?;
 /// blend.fit_grouped(&tracks, &[0, 0, 1, 2])?;
-/// assert_eq!(blend.weights("cv-time"), Some(&[1.0; 5][..]));
+/// assert_eq!(blend.weights("cv-time", 0), Some(&[1.0; 5][..]));
+/// // one speed everywhere: a single regime
+/// assert!(blend.speed_edges().is_empty());
 /// # Ok::<(), trajpred_core::Error>(())
 /// ```
 pub struct Blend {
     params: BlendParams,
     options: MethodOptions,
     members: Vec<Member>,
+    /// The speed regimes' edges (increasing; none for a single regime).
+    edges: Vec<f64>,
     summary: Option<String>,
 }
 
@@ -201,6 +142,9 @@ impl Blend {
         if params.rounds == 0 {
             return Err(invalid("rounds", "must be at least 1, got 0"));
         }
+        if params.max_regimes == 0 {
+            return Err(invalid("max_regimes", "must be at least 1, got 0"));
+        }
         params.eval.validate()?;
         for c in &params.candidates {
             if c == "blend" || c == "auto" {
@@ -218,16 +162,26 @@ impl Blend {
             params,
             options,
             members: Vec::new(),
+            edges: Vec::new(),
             summary: None,
         })
     }
 
-    /// The weights of `method` at each fitted step, if it is a member.
-    pub fn weights(&self, method: &str) -> Option<&[f64]> {
+    /// The weights of `method` at each fitted step in speed regime `regime` (0 is the
+    /// slowest; see [`Blend::speed_edges`]), if it is a member and the regime exists.
+    pub fn weights(&self, method: &str, regime: usize) -> Option<&[f64]> {
         self.members
             .iter()
             .find(|m| m.name == method)
-            .map(|m| m.weights.as_slice())
+            .and_then(|m| m.weights.get(regime))
+            .map(Vec::as_slice)
+    }
+
+    /// The speeds (m/s for tracks in metres and seconds) that split the speed regimes: a
+    /// history whose last fixes are `v` apart per second is in the regime of how many edges
+    /// `v` exceeds. Empty for a single regime (or an unfitted blend).
+    pub fn speed_edges(&self) -> &[f64] {
+        &self.edges
     }
 
     /// Every candidate's held-out forecasts on the same origins, fold by fold.
@@ -243,7 +197,7 @@ impl Blend {
             train.first().map_or(1, |t| t.dim()),
         );
         let cands = &self.params.candidates;
-        let mut truth = Vec::new();
+        let (mut truth, mut speed, mut fold_of) = (Vec::new(), Vec::new(), Vec::new());
         let mut forecasts: Vec<Option<Vec<f64>>> = vec![Some(Vec::new()); cands.len()];
         for f in 0..k {
             let (fit, fit_groups, held) = fold_split(train, groups, &fold, f);
@@ -285,7 +239,30 @@ impl Blend {
                     }
                 }
             }
-            truth.extend(fold_truth.unwrap_or_default());
+            if let Some(t) = fold_truth {
+                let speeds: Vec<f64> = held
+                    .iter()
+                    .flat_map(|tr| {
+                        self.params
+                            .eval
+                            .origins(tr.len())
+                            .map(move |o| speed_at(tr, o))
+                    })
+                    .collect();
+                if speeds.len() * h * d != t.len() {
+                    return Err(invalid(
+                        "eval",
+                        format!(
+                            "fold {f}: {} origins but {} held-out forecasts",
+                            speeds.len(),
+                            t.len() / (h * d)
+                        ),
+                    ));
+                }
+                fold_of.extend(std::iter::repeat_n(f, speeds.len()));
+                speed.extend(speeds);
+                truth.extend(t);
+            }
         }
         let forecasts: Vec<(usize, Vec<f64>)> = forecasts
             .into_iter()
@@ -311,6 +288,8 @@ impl Blend {
             dim: d,
             truth,
             forecasts,
+            speed,
+            fold: fold_of,
         })
     }
 
@@ -323,9 +302,18 @@ impl Blend {
         Ok(&self.members)
     }
 
-    /// The weighted mean of the members' forecasts `each` gives.
-    fn combine(&self, each: impl Fn(&dyn Predictor) -> Result<Forecast>) -> Result<Forecast> {
+    /// The weighted mean of the members' forecasts `each` gives, with the weights of the
+    /// speed regime of `history`'s last fixes.
+    fn combine(
+        &self,
+        history: &Trajectory,
+        each: impl Fn(&dyn Predictor) -> Result<Forecast>,
+    ) -> Result<Forecast> {
         let members = self.fitted()?;
+        let regime = regime_of(
+            &self.edges,
+            speed_at(history, history.len().saturating_sub(1)),
+        );
         let mut sum: Vec<Vec<f64>> = Vec::new();
         let mut dim = 0;
         for m in members {
@@ -345,8 +333,9 @@ impl Blend {
                     ),
                 ));
             }
+            let w = &m.weights[regime.min(m.weights.len() - 1)];
             for (k, s) in sum.iter_mut().enumerate() {
-                let w = m.weights[k.min(m.weights.len() - 1)];
+                let w = w[k.min(w.len() - 1)];
                 for (s, x) in s.iter_mut().zip(f.step(k + 1)) {
                     *s += w * x;
                 }
@@ -369,27 +358,49 @@ impl Predictor for Blend {
     fn fit_grouped(&mut self, train: &[Trajectory], groups: &[usize]) -> Result<()> {
         super::check_groups(train, groups)?;
         self.members.clear();
+        self.edges.clear();
         self.summary = None;
         let mut notes = Vec::new();
         let held = self.held_out(train, groups, &mut notes)?;
         let (h, usable) = (held.horizon, held.forecasts.len());
-        // weights[k][c]: candidate c's weight at step k
-        let mut weights = vec![vec![0.0; usable]; h];
-        let mut s = String::from("weights per step");
-        for (k, wk) in weights.iter_mut().enumerate() {
-            let (counts, rounds, e) = held.select(k, self.params.rounds);
-            let _ = write!(s, "; step {}: {e:.3} m held out,", k + 1);
-            for (c, &n) in counts.iter().enumerate() {
-                wk[c] = n as f64 / rounds as f64;
-                if n > 0 {
-                    let name = &self.params.candidates[held.forecasts[c].0];
-                    let _ = write!(s, " {name} {n}/{rounds}");
+        let all: Vec<usize> = (0..held.origins()).collect();
+        let folds = held.fold.iter().max().map_or(0, |&f| f + 1);
+        let mut s = String::from("speed regimes by cross-validation over the held-out folds");
+        let mut best = (1usize, f64::INFINITY);
+        for r in 1..=self.params.max_regimes {
+            let e = held.cv_error(r, self.params.rounds, folds);
+            let _ = write!(s, "{} {r}: {e:.3} m", if r == 1 { ":" } else { "," });
+            if e < best.1 {
+                best = (r, e);
+            }
+        }
+        let speeds: Vec<f64> = held.speed.clone();
+        let edges = quantile_edges(speeds, best.0);
+        let weights = held.fit_weights(&all, &edges, self.params.rounds);
+        let _ = write!(
+            s,
+            "; chose {} (edges {:?} m/s, {} regimes)",
+            best.0,
+            edges
+                .iter()
+                .map(|e| (e * 1000.0).round() / 1000.0)
+                .collect::<Vec<_>>(),
+            weights.len()
+        );
+        for (r, wr) in weights.iter().enumerate() {
+            for (k, wk) in wr.iter().enumerate() {
+                let _ = write!(s, "; regime {r} step {}:", k + 1);
+                for (c, &w) in wk.iter().enumerate() {
+                    if w > 0.0 {
+                        let name = &self.params.candidates[held.forecasts[c].0];
+                        let _ = write!(s, " {name} {w:.2}");
+                    }
                 }
             }
         }
         let _ = write!(s, "; candidates' held-out mean error (m):");
         for (c, f) in &held.forecasts {
-            let e = (0..h).map(|j| held.error(j, &step_sum(f, h, held.dim, j), 1.0));
+            let e = (0..h).map(|j| held.error(j, &all, &step_sum(f, h, held.dim, j), 1.0));
             let name = &self.params.candidates[*c];
             let _ = write!(s, " {name} {:.3}", e.sum::<f64>() / h as f64);
         }
@@ -397,8 +408,11 @@ impl Predictor for Blend {
             let _ = write!(s, "; {n}");
         }
         for c in 0..usable {
-            let w: Vec<f64> = weights.iter().map(|wk| wk[c]).collect();
-            if w.iter().all(|&x| x == 0.0) {
+            let w: Vec<Vec<f64>> = weights
+                .iter()
+                .map(|wr| wr.iter().map(|wk| wk[c]).collect())
+                .collect();
+            if w.iter().flatten().all(|&x| x == 0.0) {
                 continue;
             }
             let name = self.params.candidates[held.forecasts[c].0].clone();
@@ -410,16 +424,17 @@ impl Predictor for Blend {
                 weights: w,
             });
         }
+        self.edges = edges;
         self.summary = Some(s);
         Ok(())
     }
 
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
-        self.combine(|p| p.forecast(history, horizon))
+        self.combine(history, |p| p.forecast(history, horizon))
     }
 
     fn forecast_times(&self, history: &Trajectory, times: &[f64]) -> Result<Forecast> {
-        self.combine(|p| p.forecast_times(history, times))
+        self.combine(history, |p| p.forecast_times(history, times))
     }
 
     fn min_history(&self) -> usize {
@@ -430,24 +445,44 @@ impl Predictor for Blend {
             .unwrap_or(1)
     }
 
-    /// `{"members": [{"method", "weights", "params"}, ...]}`: each member, its weight at
-    /// every step and what it learned.
+    /// `{"speed_edges": [...], "members": [{"method", "weights", "params"}, ...]}`: the
+    /// speed regimes' edges, and each member with its weights (one list of per-step weights
+    /// per regime, slowest first) and what it learned.
     fn fitted_params(&self) -> Result<serde_json::Value> {
         let members = self.fitted()?;
         let mut out = Vec::with_capacity(members.len());
         for m in members {
+            let w: Vec<serde_json::Value> = m.weights.iter().map(exact_vec).collect();
             out.push(serde_json::json!({
                 "method": m.name,
-                "weights": exact_vec(&m.weights),
+                "weights": w,
                 "params": m.predictor.fitted_params()?,
             }));
         }
-        Ok(serde_json::json!({ "members": out }))
+        Ok(serde_json::json!({ "speed_edges": exact_vec(&self.edges), "members": out }))
     }
 
     fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
         let root = At::root("blend", params);
-        let [members] = root.fields(["members"])?;
+        let [edges_at, members] = root.fields(["speed_edges", "members"])?;
+        let mut edges = Vec::new();
+        let empty = edges_at.value().as_array().is_some_and(Vec::is_empty);
+        let edge_items = if empty {
+            Vec::new()
+        } else {
+            edges_at.items(None, MAX_REGIMES - 1)?
+        };
+        for e in edge_items {
+            let v = e.f64_min(0.0, false)?;
+            if edges.last().is_some_and(|&l| v <= l) {
+                return Err(e.error(format!(
+                    "must exceed the edge before it, {}",
+                    edges[edges.len() - 1]
+                )));
+            }
+            edges.push(v);
+        }
+        let regimes = edges.len() + 1;
         let items = members.items(None, self.params.candidates.len())?;
         let mut loaded: Vec<Member> = Vec::with_capacity(items.len());
         for item in &items {
@@ -463,13 +498,18 @@ impl Predictor for Blend {
                 return Err(method.error(format!("`{name}` is a member twice")));
             }
             // the first member's weights set the fitted horizon, the others must match it
-            let w: Vec<f64> = match loaded.first() {
-                Some(m) => weights.items(Some(m.weights.len()), m.weights.len())?,
-                None => weights.items(None, MAX_STEPS)?,
+            let steps = loaded.first().map(|m| m.weights[0].len());
+            let mut w = Vec::with_capacity(regimes);
+            for wr in weights.items(Some(regimes), regimes)? {
+                let wr: Vec<f64> = match steps.or(w.first().map(Vec::len)) {
+                    Some(n) => wr.items(Some(n), n)?,
+                    None => wr.items(None, MAX_STEPS)?,
+                }
+                .iter()
+                .map(|x| x.f64_min(0.0, false))
+                .collect::<Result<_>>()?;
+                w.push(wr);
             }
-            .iter()
-            .map(|x| x.f64_min(0.0, false))
-            .collect::<Result<_>>()?;
             let predictor = load_member("blend", name, &self.options, &inner)?;
             loaded.push(Member {
                 name: name.to_string(),
@@ -477,17 +517,20 @@ impl Predictor for Blend {
                 weights: w,
             });
         }
-        let steps = loaded.first().map_or(0, |m| m.weights.len());
-        for k in 0..steps {
-            let total: f64 = loaded.iter().map(|m| m.weights[k]).sum();
-            if (total - 1.0).abs() > 1e-9 {
-                return Err(members.error(format!(
-                    "the weights of step {} sum to {total}, not 1",
-                    k + 1
-                )));
+        let steps = loaded.first().map_or(0, |m| m.weights[0].len());
+        for r in 0..regimes {
+            for k in 0..steps {
+                let total: f64 = loaded.iter().map(|m| m.weights[r][k]).sum();
+                if (total - 1.0).abs() > 1e-9 {
+                    return Err(members.error(format!(
+                        "the weights of regime {r}, step {} sum to {total}, not 1",
+                        k + 1
+                    )));
+                }
             }
         }
         self.members = loaded;
+        self.edges = edges;
         self.summary = None;
         Ok(())
     }
@@ -509,52 +552,4 @@ fn step_sum(f: &[f64], h: usize, d: usize, k: usize) -> Vec<f64> {
     f.chunks(h * d)
         .flat_map(|o| o[k * d..][..d].to_vec())
         .collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::HeldOut;
-
-    /// Worked by hand: the truth is 0 at both origins; candidate A says +1 and +3, B says -1
-    /// and -3. Round 1 takes A (the first of two equal errors, 2); round 2 adds B, whose mean
-    /// with A is exact (error 0); round 3 can only make it worse (1/3 or 1). So the weights are
-    /// 1/2 and 1/2, reached at round 2 with error 0.
-    #[test]
-    fn greedy_selection_matches_the_hand_worked_case() {
-        let held = HeldOut {
-            horizon: 1,
-            dim: 1,
-            truth: vec![0.0, 0.0],
-            forecasts: vec![(0, vec![1.0, 3.0]), (1, vec![-1.0, -3.0])],
-        };
-        assert_eq!(held.select(0, 1), (vec![1, 0], 1, 2.0));
-        assert_eq!(held.select(0, 5), (vec![1, 1], 2, 0.0));
-        // a third candidate at 0 everywhere wins alone at round 1
-        let held = HeldOut {
-            forecasts: vec![
-                (0, vec![1.0, 3.0]),
-                (1, vec![-1.0, -3.0]),
-                (2, vec![0.0, 0.0]),
-            ],
-            ..held
-        };
-        assert_eq!(held.select(0, 5), (vec![0, 0, 1], 1, 0.0));
-    }
-
-    /// Step `k` is scored on step `k` only: two steps, a candidate exact at step 2 only.
-    #[test]
-    fn each_step_is_selected_on_its_own_errors() {
-        // origins x steps x 1 axis: truth (0, 10) at both origins
-        let held = HeldOut {
-            horizon: 2,
-            dim: 1,
-            truth: vec![0.0, 10.0, 0.0, 10.0],
-            forecasts: vec![
-                (0, vec![0.0, 0.0, 0.0, 0.0]),
-                (1, vec![5.0, 10.0, 5.0, 10.0]),
-            ],
-        };
-        assert_eq!(held.select(0, 3), (vec![1, 0], 1, 0.0));
-        assert_eq!(held.select(1, 3), (vec![0, 1], 1, 0.0));
-    }
 }
