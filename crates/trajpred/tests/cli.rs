@@ -145,6 +145,16 @@ fn evaluate_prints_a_table_for_every_method() {
         assert!(cells[2].parse::<usize>().unwrap() > 100, "{row}");
         assert_eq!(cells[3], "0", "{row}");
     }
+    // a method named twice runs once, in the order first named
+    let twice = evaluate("poly2,kf-dynamic,poly2", &[]);
+    assert!(twice.status.success());
+    let text = String::from_utf8(twice.stdout).unwrap();
+    let names: Vec<&str> = text
+        .lines()
+        .skip(1)
+        .map(|r| r.split(',').next().unwrap())
+        .collect();
+    assert_eq!(names, ["poly2", "kf-dynamic"], "{text}");
     // --max-origins caps the forecasts of every trajectory at that many
     let capped = evaluate("poly1", &["--max-origins", "7"]);
     assert!(capped.status.success());

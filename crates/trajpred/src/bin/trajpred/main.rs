@@ -480,7 +480,9 @@ fn run(cli: Cli) -> Result<()> {
                             max_origins_per_trajectory: max_origins,
                         },
                     );
-                    let names: Vec<&str> = methods
+                    // `all,imm` names imm twice: each method runs once, in first-named order
+                    let mut names: Vec<&str> = Vec::new();
+                    for n in methods
                         .split(',')
                         .map(str::trim)
                         .filter(|s| !s.is_empty())
@@ -488,7 +490,11 @@ fn run(cli: Cli) -> Result<()> {
                             "all" => leaderboard_methods(),
                             _ => vec![s],
                         })
-                        .collect();
+                    {
+                        if !names.contains(&n) {
+                            names.push(n);
+                        }
+                    }
                     if names.is_empty() {
                         bail!("--methods names no method");
                     }
