@@ -332,3 +332,111 @@ fn cv_time_extrapolates_the_last_velocity_on_the_mean_interval() {
         })
     ));
 }
+
+/// A seeded AR(2) series plus a slow sine of amplitude `wave` and a frequency of its own
+/// (a GSC fitted on other series' frequencies misses it by a slowly varying amount: its
+/// one-step residuals are correlated and the Kalman correction has something to correct).
+fn ar2_series(seed: u64, wave: f64, n: usize) -> Vec<f64> {
+    let mut state = seed;
+    let mut u = move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+    };
+    let mut x = vec![0.0, 1.0];
+    for i in 2..n {
+        let e = u();
+        x.push(1.6 * x[i - 1] - 0.8 * x[i - 2] + e);
+    }
+    x.iter()
+        .enumerate()
+        .map(|(i, v)| v + wave * (0.02 * (seed % 7) as f64 * i as f64).sin())
+        .collect()
+}
+
+/// GSKF's cross-validation by group worked out here for T = 1: per held-out group, the GSC
+/// fitted on the other groups, its converged scalar gain from the recursion of
+/// `gskf_correction_matches_a_scalar_recursion_by_hand`, and the pooled squared error of the
+/// plain GSC against the corrected forecast (q = 1 x the residual variance). Plain AR(2)
+/// tracks have uncorrelated residuals and the correction only adds noise: the plain GSC
+/// must win, and the forecast is then the GSC's to the bit. With a large slow sine of a
+/// different frequency in each series the residuals are correlated; whichever wins by hand
+/// must be the one chosen.
+#[test]
+fn gskf_chooses_between_gsc_and_its_correction_by_held_out_groups() {
+    for drift in [false, true] {
+        let series: Vec<Vec<f64>> = (0..4)
+            .map(|g| ar2_series(100 + g, if drift { 20.0 } else { 0.0 }, 300))
+            .collect();
+        let tracks: Vec<Trajectory> = series
+            .iter()
+            .map(|x| Trajectory::uniform(0.0, 1.0, vec![x.clone()]).unwrap())
+            .collect();
+        let params = GskfParams {
+            window: 2,
+            horizons: 1,
+            q: None,
+            q_grid: vec![0.01],
+        };
+        // by hand: 4 groups, so each fold holds out one group
+        let (mut off, mut on) = (0.0, 0.0);
+        for held in 0..4 {
+            let others: Vec<Trajectory> = (0..4)
+                .filter(|&g| g != held)
+                .map(|g| tracks[g].clone())
+                .collect();
+            let mut gsc = Gsc::new(params.clone()).unwrap();
+            gsc.fit(&others).unwrap();
+            let coder = &gsc.coders()[0];
+            let (a, r) = (coder.coefficients()[(0, 1)], coder.residual_variances()[0]);
+            let q = 0.01 * r;
+            let (mut post, mut s_prev, mut k) = (r, a * a * r + q + r, 0.0);
+            for _ in 0..10_000 {
+                let prior = a * a * post + q;
+                k = prior / s_prev;
+                post = (1.0 - k) * (1.0 - k) * prior + k * k * r;
+                s_prev = prior + r;
+            }
+            let x = &series[held];
+            let g = |i: usize| {
+                gsc.forecast(&tracks[held].prefix(i + 1).unwrap(), 1)
+                    .unwrap()
+                    .step(1)[0]
+            };
+            for i in 2..x.len() - 1 {
+                let plain = g(i);
+                off += (plain - x[i + 1]).powi(2);
+                on += (plain + k * (x[i] - g(i - 1)) - x[i + 1]).powi(2);
+            }
+        }
+        if !drift {
+            assert!(off < on, "plain {off}, corrected {on}");
+        }
+        let mut gskf = Gskf::new(params.clone()).unwrap();
+        gskf.fit_grouped(&tracks, &[0, 1, 2, 3]).unwrap();
+        let chosen = gskf.process_noise()[0];
+        assert_eq!(
+            chosen.is_none(),
+            off < on,
+            "drift {drift}: chose {chosen:?}"
+        );
+        let summary = gskf.fitted_summary().unwrap();
+        assert!(summary.contains("cross-validation by group"), "{summary}");
+        if chosen.is_none() {
+            let mut gsc = Gsc::new(params.clone()).unwrap();
+            gsc.fit(&tracks).unwrap();
+            let h = tracks[0].prefix(200).unwrap();
+            assert_eq!(
+                gskf.forecast(&h, 1).unwrap().step(1),
+                gsc.forecast(&h, 1).unwrap().step(1)
+            );
+        }
+        // the choice survives saving and loading
+        let mut loaded = Gskf::new(params).unwrap();
+        loaded
+            .load_fitted_params(&gskf.fitted_params().unwrap())
+            .unwrap();
+        assert_eq!(loaded.process_noise(), gskf.process_noise());
+    }
+}

@@ -95,7 +95,9 @@ fn tables_1_2(ctx: &Context, s: &Setup, series: &Trajectory, out: &mut Computed)
         let gs = score(&gp, &truth, t)?;
         let mut k = gskf(s.window, t)?;
         k.fit(std::slice::from_ref(&train))?;
-        chosen_q.push(format!("T = {t}: {}", fmt_list(&k.process_noise())));
+        // one training series: q is chosen in sample and the correction is always on
+        let q: Vec<f64> = k.process_noise().into_iter().flatten().collect();
+        chosen_q.push(format!("T = {t}: {}", fmt_list(&q)));
         let ks = score(&predict_test(&k, series, t, s.test_points)?, &truth, t)?;
         out.table("table2").rows.push(
             Row::new(format!("T{t}"))
