@@ -147,7 +147,9 @@ fn loaded_parameters_forecast_bit_for_bit_as_the_fitted_methods() {
                 "imm",
                 "aligned-ridge",
                 "auto",
-                "blend"
+                "blend",
+                "pf",
+                "mkpf"
             ]
             .contains(name),
             "{name}"

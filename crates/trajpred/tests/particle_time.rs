@@ -80,3 +80,50 @@ fn particle_filters_run_every_minute_long_step_without_failure() {
         r.mean_euclidean_all
     );
 }
+
+/// The noise the particle filters fit is the constant-velocity model's maximum-likelihood fit
+/// (`kf-cv`'s), and with it the bootstrap filter tracks minute-long steps that its default
+/// density (for 1-5 s phone fixes) could not: fitted on other taxis, it beats standing still.
+#[test]
+fn particle_filters_fit_their_noise_and_track_minute_long_steps_with_it() {
+    let train: Vec<Trajectory> = (10..16).map(|s| taxi(s, 40)).collect();
+    let test: Vec<Trajectory> = (0..4).map(|s| taxi(s, 40)).collect();
+    let cfg = EvalConfig {
+        history: 15,
+        horizon: 3,
+        stride: 5,
+        ..EvalConfig::default()
+    };
+    let mut kf = build("kf-cv", &MethodOptions::default()).expect("kf-cv");
+    kf.fit(&train).expect("kf-cv fits");
+    let kf_params = kf.fitted_params().expect("fitted");
+    let mut moved = 0.0;
+    let mut count = 0.0;
+    for tr in &test {
+        for o in cfg.origins(tr.len()) {
+            for k in 1..=cfg.horizon {
+                let (a, b) = (tr.point(o), tr.point(o + k));
+                moved += ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
+                count += 1.0;
+            }
+        }
+    }
+    let persistence = moved / count;
+    for name in ["pf", "mkpf"] {
+        let mut p = build(name, &MethodOptions::default()).expect("method");
+        p.fit(&train).expect("fits");
+        let saved = p.fitted_params().expect("fitted");
+        assert_eq!(
+            saved["accel_density"], kf_params["spectral_density"],
+            "{name}"
+        );
+        assert_eq!(saved["obs_var"], kf_params["r"], "{name}");
+        let r = evaluate(p.as_ref(), &test, &cfg, None).expect("evaluates");
+        assert_eq!(r.failures, 0, "{name}: {:?}", r.first_failure);
+        assert!(
+            r.mean_euclidean_all < 0.5 * persistence,
+            "{name}: {} m against {persistence} m standing still",
+            r.mean_euclidean_all
+        );
+    }
+}

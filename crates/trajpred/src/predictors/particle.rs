@@ -1,7 +1,8 @@
 //! Particle-filter predictors (`docs/papers.md` C): the bootstrap particle filter and the MKPF
 //! (UKF + EKF proposal), with a constant-velocity model and position observations.
 
-use super::{invalid, positions_forecast, step_interval};
+use super::fitted::{At, exact};
+use super::{KfTime, KfTimeParams, invalid, positions_forecast, step_interval};
 use nalgebra::{DMatrix, DVector, Dyn};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -42,6 +43,10 @@ pub struct ParticleParams {
     /// Seed: every forecast restarts its generator from it, so the same history gives the
     /// same forecast.
     pub seed: u64,
+    /// At [`Predictor::fit`], replace `accel_density` and `obs_var` by the maximum-likelihood
+    /// fit of the same constant-velocity model on the training tracks (`kf-cv`'s fit,
+    /// [`KfTime`](super::KfTime); the filter's model and its noise are the Kalman filter's).
+    pub fit_noise: bool,
 }
 
 impl ParticleParams {
@@ -57,6 +62,7 @@ impl ParticleParams {
             obs_var: 10.0,
             p0: 100.0,
             seed: 0,
+            fit_noise: true,
         }
     }
 }
@@ -119,16 +125,44 @@ impl Predictor for ParticlePredictor {
         self.method()
     }
 
-    fn fit(&mut self, _train: &[Trajectory]) -> Result<()> {
+    fn fit(&mut self, train: &[Trajectory]) -> Result<()> {
+        if !self.params.fit_noise {
+            return Ok(());
+        }
+        let mut kf = KfTime::new(KfTimeParams {
+            derivatives: 2,
+            ..Default::default()
+        })?;
+        kf.fit(train)?;
+        self.params.accel_density = kf.params().spectral_density;
+        self.params.obs_var = kf.params().r;
         Ok(())
     }
 
+    fn fitted_summary(&self) -> Option<String> {
+        self.params.fit_noise.then(|| {
+            format!(
+                "accel_density = {:.4e} m^2/s^3, obs_var = {:.4e} m^2 (kf-cv's maximum-likelihood fit)",
+                self.params.accel_density, self.params.obs_var
+            )
+        })
+    }
+
+    /// `{"accel_density", "obs_var"}`: the noise the filter runs with (fitted or given).
     fn fitted_params(&self) -> Result<serde_json::Value> {
-        Ok(serde_json::Value::Null)
+        Ok(serde_json::json!({
+            "accel_density": exact(self.params.accel_density),
+            "obs_var": exact(self.params.obs_var),
+        }))
     }
 
     fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
-        trajpred_core::load_nothing(self.name(), params)
+        let root = At::root(self.method(), params);
+        let [q, r] = root.fields(["accel_density", "obs_var"])?;
+        let (q, r) = (q.f64_min(0.0, true)?, r.f64_min(0.0, true)?);
+        self.params.accel_density = q;
+        self.params.obs_var = r;
+        Ok(())
     }
 
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
