@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 use trajpred::harness::{EvalConfig, evaluate};
 use trajpred::predictors::{ParticleKind, ParticleParams, ParticlePredictor};
 use trajpred::registry::{MethodOptions, build};
-use trajpred_core::Trajectory;
+use trajpred_core::{Predictor, Trajectory};
 
 /// A taxi at 8 m/s along a gentle curve, fixes 30..300 s apart, 20 m GPS noise.
 fn taxi(seed: u64, n: usize) -> Trajectory {
@@ -81,9 +81,10 @@ fn particle_filters_run_every_minute_long_step_without_failure() {
     );
 }
 
-/// The noise the particle filters fit is the constant-velocity model's maximum-likelihood fit
-/// (`kf-cv`'s), and with it the bootstrap filter tracks minute-long steps that its default
-/// density (for 1-5 s phone fixes) could not: fitted on other taxis, it beats standing still.
+/// With `fit_noise`, the noise the particle filters fit is the constant-velocity model's
+/// maximum-likelihood fit (`kf-cv`'s), and with it the bootstrap filter tracks these
+/// simulated minute-long steps that its default density (for 1-5 s phone fixes) could not:
+/// fitted on other taxis, it beats standing still.
 #[test]
 fn particle_filters_fit_their_noise_and_track_minute_long_steps_with_it() {
     let train: Vec<Trajectory> = (10..16).map(|s| taxi(s, 40)).collect();
@@ -109,8 +110,13 @@ fn particle_filters_fit_their_noise_and_track_minute_long_steps_with_it() {
         }
     }
     let persistence = moved / count;
-    for name in ["pf", "mkpf"] {
-        let mut p = build(name, &MethodOptions::default()).expect("method");
+    for kind in [ParticleKind::Bootstrap, ParticleKind::Mkpf] {
+        let mut p = ParticlePredictor::new(ParticleParams {
+            fit_noise: true,
+            ..ParticleParams::new(kind)
+        })
+        .expect("params");
+        let name = p.name().to_string();
         p.fit(&train).expect("fits");
         let saved = p.fitted_params().expect("fitted");
         assert_eq!(
@@ -118,7 +124,7 @@ fn particle_filters_fit_their_noise_and_track_minute_long_steps_with_it() {
             "{name}"
         );
         assert_eq!(saved["obs_var"], kf_params["r"], "{name}");
-        let r = evaluate(p.as_ref(), &test, &cfg, None).expect("evaluates");
+        let r = evaluate(&p, &test, &cfg, None).expect("evaluates");
         assert_eq!(r.failures, 0, "{name}: {:?}", r.first_failure);
         assert!(
             r.mean_euclidean_all < 0.5 * persistence,
@@ -126,4 +132,10 @@ fn particle_filters_fit_their_noise_and_track_minute_long_steps_with_it() {
             r.mean_euclidean_all
         );
     }
+    // off by default (see docs/particle.md): fit leaves the given noise alone
+    let mut p = build("pf", &MethodOptions::default()).expect("pf");
+    p.fit(&train).expect("fits");
+    let saved = p.fitted_params().expect("params");
+    assert_eq!(saved["accel_density"], "1.0");
+    assert_eq!(saved["obs_var"], "10.0");
 }

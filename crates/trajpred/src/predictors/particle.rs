@@ -46,6 +46,8 @@ pub struct ParticleParams {
     /// At [`Predictor::fit`], replace `accel_density` and `obs_var` by the maximum-likelihood
     /// fit of the same constant-velocity model on the training tracks (`kf-cv`'s fit,
     /// [`KfTime`](super::KfTime); the filter's model and its noise are the Kalman filter's).
+    /// Off by default: on T-Drive's 300 s steps the fitted noise made both filters far worse
+    /// than the defaults (`docs/particle.md`).
     pub fit_noise: bool,
 }
 
@@ -62,7 +64,7 @@ impl ParticleParams {
             obs_var: 10.0,
             p0: 100.0,
             seed: 0,
-            fit_noise: true,
+            fit_noise: false,
         }
     }
 }
