@@ -26,6 +26,23 @@ fn taxi(seed: u64, n: usize) -> Trajectory {
     Trajectory::from_axes(times, vec![x, y]).expect("track")
 }
 
+/// The mean distance the targets cover over the forecast offsets of `cfg`: the error of
+/// standing still.
+fn persistence(tracks: &[Trajectory], cfg: &EvalConfig) -> f64 {
+    let mut moved = 0.0;
+    let mut count = 0.0;
+    for tr in tracks {
+        for o in cfg.origins(tr.len()) {
+            for k in 1..=cfg.horizon {
+                let (a, b) = (tr.point(o), tr.point(o + k));
+                moved += ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
+                count += 1.0;
+            }
+        }
+    }
+    moved / count
+}
+
 #[test]
 fn particle_filters_run_every_minute_long_step_without_failure() {
     let tracks: Vec<Trajectory> = (0..4).map(|s| taxi(s, 40)).collect();
@@ -35,19 +52,7 @@ fn particle_filters_run_every_minute_long_step_without_failure() {
         stride: 5,
         ..EvalConfig::default()
     };
-    // persistence bound: the mean distance a taxi covers over the forecast offsets
-    let mut moved = 0.0;
-    let mut count = 0.0;
-    for tr in &tracks {
-        for o in cfg.origins(tr.len()) {
-            for k in 1..=cfg.horizon {
-                let (a, b) = (tr.point(o), tr.point(o + k));
-                moved += ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
-                count += 1.0;
-            }
-        }
-    }
-    let persistence = moved / count;
+    let persistence = persistence(&tracks, &cfg);
     for name in ["pf", "mkpf"] {
         let p = build(name, &MethodOptions::default()).expect("method");
         let r = evaluate(p.as_ref(), &tracks, &cfg, None).expect("evaluates");
@@ -98,18 +103,7 @@ fn particle_filters_fit_their_noise_and_track_minute_long_steps_with_it() {
     let mut kf = build("kf-cv", &MethodOptions::default()).expect("kf-cv");
     kf.fit(&train).expect("kf-cv fits");
     let kf_params = kf.fitted_params().expect("fitted");
-    let mut moved = 0.0;
-    let mut count = 0.0;
-    for tr in &test {
-        for o in cfg.origins(tr.len()) {
-            for k in 1..=cfg.horizon {
-                let (a, b) = (tr.point(o), tr.point(o + k));
-                moved += ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
-                count += 1.0;
-            }
-        }
-    }
-    let persistence = moved / count;
+    let persistence = persistence(&test, &cfg);
     for kind in [ParticleKind::Bootstrap, ParticleKind::Mkpf] {
         let mut p = ParticlePredictor::new(ParticleParams {
             fit_noise: true,

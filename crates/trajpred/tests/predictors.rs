@@ -145,6 +145,20 @@ fn gsc_and_gskf_are_exact_on_noiseless_eq20() {
     }
 }
 
+/// The converged gain of the scalar IKF recursion, written out by hand: from `P+ = r`,
+/// `S = a^2 r + q + r`, iterate `P- = a^2 P+ + q`, `K = P- / S(previous)`,
+/// `P+ = (1 - K)^2 P- + K^2 r`, `S = P- + r`.
+fn scalar_gain(a: f64, r: f64, q: f64) -> f64 {
+    let (mut post, mut s_prev, mut k) = (r, a * a * r + q + r, 0.0);
+    for _ in 0..10_000 {
+        let prior = a * a * post + q;
+        k = prior / s_prev;
+        post = (1.0 - k) * (1.0 - k) * prior + k * k * r;
+        s_prev = prior + r;
+    }
+    k
+}
+
 /// The IKF correction with T = 1 against a scalar recursion written out here: the converged
 /// gain K = P(k|k-1) / S(k-1) of `P- = a^2 P+ + q`, `S = P-(previous) + r`,
 /// `P+ = (1 - K)^2 P- + K^2 r`, and the forecast `x_hat^0 + K (x_i - x_hat^0(i - 1))`.
@@ -176,13 +190,7 @@ fn gskf_correction_matches_a_scalar_recursion_by_hand() {
     let coder = &gsc.coders()[0];
     let a = coder.coefficients()[(0, 1)]; // F = the T = 1 predicted column of A
     let r = coder.residual_variances()[0];
-    let (mut post, mut s_prev, mut k) = (r, a * a * r + q + r, 0.0);
-    for _ in 0..10_000 {
-        let prior = a * a * post + q;
-        k = prior / s_prev;
-        post = (1.0 - k) * (1.0 - k) * prior + k * k * r;
-        s_prev = prior + r;
-    }
+    let k = scalar_gain(a, r, q);
     for origin in [320, 350, 398] {
         let h = tr.prefix(origin + 1).unwrap();
         let g_now = gsc.forecast(&h, 1).unwrap().step(1)[0];
@@ -390,14 +398,7 @@ fn gskf_chooses_between_gsc_and_its_correction_by_held_out_groups() {
             gsc.fit(&others).unwrap();
             let coder = &gsc.coders()[0];
             let (a, r) = (coder.coefficients()[(0, 1)], coder.residual_variances()[0]);
-            let q = 0.01 * r;
-            let (mut post, mut s_prev, mut k) = (r, a * a * r + q + r, 0.0);
-            for _ in 0..10_000 {
-                let prior = a * a * post + q;
-                k = prior / s_prev;
-                post = (1.0 - k) * (1.0 - k) * prior + k * k * r;
-                s_prev = prior + r;
-            }
+            let k = scalar_gain(a, r, 0.01 * r);
             let x = &series[held];
             let g = |i: usize| {
                 gsc.forecast(&tracks[held].prefix(i + 1).unwrap(), 1)
