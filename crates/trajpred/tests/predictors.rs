@@ -386,6 +386,7 @@ fn gskf_chooses_between_gsc_and_its_correction_by_held_out_groups() {
             horizons: 1,
             q: None,
             q_grid: vec![0.01],
+            choose_steps: false,
         };
         // by hand: 4 groups, so each fold holds out one group
         let (mut off, mut on) = (0.0, 0.0);
@@ -440,4 +441,67 @@ fn gskf_chooses_between_gsc_and_its_correction_by_held_out_groups() {
             .unwrap();
         assert_eq!(loaded.process_noise(), gskf.process_noise());
     }
+}
+
+/// GSC's LAR stop chosen on held-out groups, recomputed here through `trajpred_sparse`
+/// directly: per held-out group, the coder of the other groups for the full path and for 1
+/// step (window 2, T = 1, one axis), and its pooled absolute error on the held-out series;
+/// the option with the lower error (the full path on ties) is the one `fit_grouped` must
+/// fit on all the groups, coefficient for coefficient. Without groups, `fit` keeps the full
+/// path.
+#[test]
+fn gsc_stops_its_lar_path_where_held_out_groups_say() {
+    use trajpred_sparse::{GroupSparseCoder, Lars};
+    let series: Vec<Vec<f64>> = (0..4).map(|g| ar2_series(200 + g, 0.0, 200)).collect();
+    let tracks: Vec<Trajectory> = series
+        .iter()
+        .map(|x| Trajectory::uniform(0.0, 1.0, vec![x.clone()]).unwrap())
+        .collect();
+    let params = GskfParams {
+        window: 2,
+        horizons: 1,
+        ..Default::default()
+    };
+    let coder = |steps: Option<usize>, of: &[&[f64]]| {
+        let mut p = GroupSparseCoder::params(2, 1);
+        if let Some(s) = steps {
+            p = p.lars(Lars::params().max_steps(s));
+        }
+        p.fit_many(of).unwrap()
+    };
+    let mut error = [0.0; 2]; // full path, 1 step
+    for held in 0..4 {
+        let others: Vec<&[f64]> = (0..4)
+            .filter(|&g| g != held)
+            .map(|g| series[g].as_slice())
+            .collect();
+        for (o, steps) in [None, Some(1)].into_iter().enumerate() {
+            let c = coder(steps, &others);
+            let x = &series[held];
+            for i in 2..x.len() - 1 {
+                error[o] += (c.predict(&x[i - 1..=i]).unwrap()[0] - x[i + 1]).abs();
+            }
+        }
+    }
+    let all: Vec<&[f64]> = series.iter().map(Vec::as_slice).collect();
+    let want = coder(if error[1] < error[0] { Some(1) } else { None }, &all);
+    let mut gsc = Gsc::new(params.clone()).unwrap();
+    gsc.fit_grouped(&tracks, &[0, 1, 2, 3]).unwrap();
+    assert_eq!(
+        gsc.coders()[0].coefficients(),
+        want.coefficients(),
+        "{error:?}"
+    );
+    assert!(gsc.fitted_summary().unwrap().contains("LAR steps"));
+    // the two options differ here, so the comparison above can fail
+    assert_ne!(
+        coder(None, &all).coefficients(),
+        coder(Some(1), &all).coefficients()
+    );
+    let mut plain = Gsc::new(params).unwrap();
+    plain.fit(&tracks).unwrap();
+    assert_eq!(
+        plain.coders()[0].coefficients(),
+        coder(None, &all).coefficients()
+    );
 }

@@ -21,7 +21,9 @@ use trajpred_core::{
     Error, Forecast, Gaussian, Predictor, Result, Trajectory, check_forecast_args,
 };
 use trajpred_kalman::{Ikf, Innovation, LinearObservation, LinearTransition};
-use trajpred_sparse::GroupSparseCoder;
+use trajpred_sparse::{GroupSparseCoder, Lars};
+
+mod steps;
 
 /// Parameters of [`Gsc`] and [`Gskf`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -36,6 +38,10 @@ pub struct GskfParams {
     pub q: Option<f64>,
     /// The multipliers of the mean GSC residual variance tried when `q` is `None`.
     pub q_grid: Vec<f64>,
+    /// When fitted on trajectories of several groups (`fit_grouped`), stop each axis's LAR
+    /// paths where held-out groups say (the full path or 1 to m - 1 steps, by 5-fold
+    /// cross-validation by group; see `docs/gskf.md`). One group, or `false`: the full path.
+    pub choose_steps: bool,
 }
 
 impl Default for GskfParams {
@@ -45,6 +51,7 @@ impl Default for GskfParams {
             horizons: 6,
             q: None,
             q_grid: vec![1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0],
+            choose_steps: true,
         }
     }
 }
@@ -97,10 +104,18 @@ fn axis_series(train: &[Trajectory], axis: usize, needed: usize) -> Vec<&[f64]> 
         .collect()
 }
 
-fn fit_gsc(params: &GskfParams, series: &[&[f64]]) -> Result<GroupSparseCoder> {
-    GroupSparseCoder::params(params.window, params.horizons)
-        .fit_many(series)
-        .map_err(sparse_error)
+/// The GSC of one axis; `steps` stops every horizon's LAR path after that many steps
+/// (`None`: the full path, whose end is least squares).
+fn fit_gsc(
+    params: &GskfParams,
+    series: &[&[f64]],
+    steps: Option<usize>,
+) -> Result<GroupSparseCoder> {
+    let mut gsc = GroupSparseCoder::params(params.window, params.horizons);
+    if let Some(s) = steps {
+        gsc = gsc.lars(Lars::params().max_steps(s));
+    }
+    gsc.fit_many(series).map_err(sparse_error)
 }
 
 /// The GSC prediction made at origin `i` (window ending at index `i`) of `x`.
@@ -318,6 +333,8 @@ pub struct Gsc {
     params: GskfParams,
     #[serde(skip)]
     axes: Vec<GroupSparseCoder>,
+    #[serde(skip)]
+    summary: Option<String>,
 }
 
 impl Gsc {
@@ -327,6 +344,7 @@ impl Gsc {
         Ok(Gsc {
             params,
             axes: Vec::new(),
+            summary: None,
         })
     }
 
@@ -385,7 +403,13 @@ fn check_history(
     Ok(())
 }
 
-fn fit_axes(params: &GskfParams, train: &[Trajectory]) -> Result<Vec<GroupSparseCoder>> {
+/// Every axis's GSC; `steps[a]` stops axis `a`'s LAR paths (the full path where `steps` is
+/// shorter).
+fn fit_axes(
+    params: &GskfParams,
+    train: &[Trajectory],
+    steps: &[Option<usize>],
+) -> Result<Vec<GroupSparseCoder>> {
     let dim = train
         .first()
         .ok_or(Error::Empty {
@@ -401,7 +425,13 @@ fn fit_axes(params: &GskfParams, train: &[Trajectory]) -> Result<Vec<GroupSparse
     }
     let needed = params.window + params.horizons + 1;
     (0..dim)
-        .map(|a| fit_gsc(params, &axis_series(train, a, needed)))
+        .map(|a| {
+            fit_gsc(
+                params,
+                &axis_series(train, a, needed),
+                steps.get(a).copied().flatten(),
+            )
+        })
         .collect()
 }
 
@@ -410,9 +440,28 @@ impl Predictor for Gsc {
         "gsc"
     }
 
+    /// The full LAR path on every axis (no groups to hold out).
     fn fit(&mut self, train: &[Trajectory]) -> Result<()> {
-        self.axes = fit_axes(&self.params, train)?;
+        self.axes = fit_axes(&self.params, train, &[])?;
+        self.summary = None;
         Ok(())
+    }
+
+    /// With trajectories of several groups and `choose_steps`, each axis's LAR paths stop
+    /// where held-out groups say (see `docs/gskf.md`); otherwise as [`Predictor::fit`].
+    fn fit_grouped(&mut self, train: &[Trajectory], groups: &[usize]) -> Result<()> {
+        super::check_groups(train, groups)?;
+        if !self.params.choose_steps || distinct(groups) < 2 {
+            return self.fit(train);
+        }
+        let (steps, said) = steps::choose_steps(&self.params, train, groups)?;
+        self.axes = fit_axes(&self.params, train, &steps)?;
+        self.summary = Some(said);
+        Ok(())
+    }
+
+    fn fitted_summary(&self) -> Option<String> {
+        self.summary.clone()
     }
 
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
@@ -484,7 +533,7 @@ impl Gskf {
     /// Chooses per axis, on the training series, the `q` of the grid with the lowest
     /// in-sample mean squared error (one group: nothing to hold out).
     fn fit_in_sample(&self, train: &[Trajectory]) -> Result<Vec<AxisFilter>> {
-        let coders = fit_axes(&self.params, train)?;
+        let coders = fit_axes(&self.params, train, &[])?;
         let needed = self.params.window + self.params.horizons + 1;
         coders
             .into_iter()
@@ -524,6 +573,7 @@ impl Gskf {
         &self,
         train: &[Trajectory],
         groups: &[usize],
+        steps: &[Option<usize>],
     ) -> Result<(Vec<AxisFilter>, String)> {
         let (fold, k) = fold_of_trajectories(groups, CV_FOLDS, 0)?;
         let needed = self.params.window + self.params.horizons + 1;
@@ -532,7 +582,7 @@ impl Gskf {
         let mut sae: Vec<Vec<(f64, usize)>> = Vec::new();
         for f in 0..k {
             let (fit, _, held) = fold_split(train, groups, &fold, f);
-            let Ok(coders) = fit_axes(&self.params, &fit) else {
+            let Ok(coders) = fit_axes(&self.params, &fit, steps) else {
                 continue;
             };
             sae.resize(coders.len(), vec![(0.0, 0); grid.len() + 1]);
@@ -557,7 +607,7 @@ impl Gskf {
                 }
             }
         }
-        let coders = fit_axes(&self.params, train)?;
+        let coders = fit_axes(&self.params, train, steps)?;
         let mut said = format!("chosen per axis by {k}-fold cross-validation by group");
         let mut axes = Vec::with_capacity(coders.len());
         for (a, gsc) in coders.into_iter().enumerate() {
@@ -595,8 +645,16 @@ impl Gskf {
     }
 }
 
-/// Folds of [`Gskf`]'s cross-validation by group.
+/// Folds of [`Gskf`]'s and [`Gsc`]'s cross-validations by group.
 const CV_FOLDS: usize = 5;
+
+/// How many different groups `groups` holds.
+fn distinct(groups: &[usize]) -> usize {
+    let mut g = groups.to_vec();
+    g.sort_unstable();
+    g.dedup();
+    g.len()
+}
 
 /// The mean of a coder's per-horizon residual variances, the unit of `q`.
 fn mean_residual_variance(gsc: &GroupSparseCoder) -> f64 {
@@ -620,15 +678,16 @@ impl Predictor for Gskf {
         super::check_groups(train, groups)?;
         self.axes.clear();
         self.summary = None;
-        let mut distinct = groups.to_vec();
-        distinct.sort_unstable();
-        distinct.dedup();
-        if self.params.q.is_some() || distinct.len() < 2 {
+        if self.params.q.is_some() || distinct(groups) < 2 {
             self.axes = self.fit_in_sample(train)?;
         } else {
-            let (axes, said) = self.fit_cross_validated(train, groups)?;
+            let (steps, steps_said) = match self.params.choose_steps {
+                true => steps::choose_steps(&self.params, train, groups)?,
+                false => (Vec::new(), "full LAR paths".to_string()),
+            };
+            let (axes, said) = self.fit_cross_validated(train, groups, &steps)?;
             self.axes = axes;
-            self.summary = Some(said);
+            self.summary = Some(format!("{said}; {steps_said}"));
         }
         Ok(())
     }
