@@ -363,6 +363,14 @@ fn ar2_series(seed: u64, wave: f64, n: usize) -> Vec<f64> {
         .collect()
 }
 
+/// One-axis tracks sampled once a second, one per series.
+fn one_axis_tracks(series: &[Vec<f64>]) -> Vec<Trajectory> {
+    series
+        .iter()
+        .map(|x| Trajectory::uniform(0.0, 1.0, vec![x.clone()]).unwrap())
+        .collect()
+}
+
 /// GSKF's cross-validation by group worked out here for T = 1: per held-out group, the GSC
 /// fitted on the other groups, its converged scalar gain from the recursion of
 /// `gskf_correction_matches_a_scalar_recursion_by_hand`, and the pooled squared error of the
@@ -377,10 +385,7 @@ fn gskf_chooses_between_gsc_and_its_correction_by_held_out_groups() {
         let series: Vec<Vec<f64>> = (0..4)
             .map(|g| ar2_series(100 + g, if drift { 20.0 } else { 0.0 }, 300))
             .collect();
-        let tracks: Vec<Trajectory> = series
-            .iter()
-            .map(|x| Trajectory::uniform(0.0, 1.0, vec![x.clone()]).unwrap())
-            .collect();
+        let tracks = one_axis_tracks(&series);
         let params = GskfParams {
             window: 2,
             horizons: 1,
@@ -453,10 +458,7 @@ fn gskf_chooses_between_gsc_and_its_correction_by_held_out_groups() {
 fn gsc_stops_its_lar_path_where_held_out_groups_say() {
     use trajpred_sparse::{GroupSparseCoder, Lars};
     let series: Vec<Vec<f64>> = (0..4).map(|g| ar2_series(200 + g, 0.0, 200)).collect();
-    let tracks: Vec<Trajectory> = series
-        .iter()
-        .map(|x| Trajectory::uniform(0.0, 1.0, vec![x.clone()]).unwrap())
-        .collect();
+    let tracks = one_axis_tracks(&series);
     let params = GskfParams {
         window: 2,
         horizons: 1,
