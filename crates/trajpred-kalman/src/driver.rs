@@ -84,7 +84,7 @@ pub fn check_dt<T: RealField + Copy>(dt: T, what: &'static str) -> Result<()> {
 /// The one recursion behind every run of a trajpred filter over a sequence: `step` is called
 /// for each input in order with the output of the previous call (`None` for the first), and
 /// the outputs are collected; the first error stops the run. [`drive`],
-/// [`Filter::filter`], [`Filter::forecast`],
+/// [`drive_each`], [`Filter::filter`], [`Filter::forecast`],
 /// the IKF, the augmented UKF and the predictor form all run through it.
 ///
 /// ```
@@ -109,15 +109,15 @@ where
 
 /// The driver's loop: the filter's estimate is at `times[0]`; for each later time it advances by
 /// the interval and updates with the observation there (`None`: missing), then calls
-/// `after(k, filter)` (for example to forecast from there). Returns the estimate after each
-/// time `times[1..]`. `observations[0]` is not used (the estimate at `times[0]` is the
-/// filter's starting point); times must increase strictly.
-pub fn drive<T, D, M, F, A>(
+/// `after(k, filter)` (for example to forecast from there, or to keep the estimate). Nothing
+/// is collected: [`drive`] is this loop keeping every estimate. `observations[0]` is not used
+/// (the estimate at `times[0]` is the filter's starting point); times must increase strictly.
+pub fn drive_each<T, D, M, F, A>(
     filter: &mut F,
     times: &[T],
     observations: &[Option<OVector<T, M>>],
     mut after: A,
-) -> std::result::Result<Vec<Gaussian<T, D>>, F::Error>
+) -> std::result::Result<(), F::Error>
 where
     T: RealField + Copy,
     D: Dim,
@@ -134,14 +134,38 @@ where
         })
         .into());
     }
+    // a `Vec<()>` never allocates
     scan(1..times.len(), |_, k| {
         let dt = times[k] - times[k - 1];
         check_dt(dt, "times")?;
         filter.advance(dt, observations[k].as_ref())?;
-        let estimate = filter.estimate()?;
-        after(k, filter)?;
-        Ok(estimate)
+        after(k, filter)
     })
+    .map(drop)
+}
+
+/// [`drive_each`] keeping the estimate after each time `times[1..]` (taken before
+/// `after(k, filter)` is called), which it returns.
+pub fn drive<T, D, M, F, A>(
+    filter: &mut F,
+    times: &[T],
+    observations: &[Option<OVector<T, M>>],
+    mut after: A,
+) -> std::result::Result<Vec<Gaussian<T, D>>, F::Error>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    F: TimeStepFilter<T, D, M> + ?Sized,
+    A: FnMut(usize, &F) -> std::result::Result<(), F::Error>,
+    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M>,
+{
+    let mut estimates = Vec::with_capacity(times.len().saturating_sub(1));
+    drive_each(filter, times, observations, |k, f| {
+        estimates.push(f.estimate()?);
+        after(k, f)
+    })?;
+    Ok(estimates)
 }
 
 /// A Gaussian [`Filter`] run by time steps: `make(dt)` builds the filter (its transition and
@@ -196,15 +220,14 @@ where
 
     fn advance(&mut self, dt: T, z: Option<&OVector<T, M>>) -> Result<()> {
         check_dt(dt, "dt")?;
-        let filter = match self.built.take() {
-            Some((built_dt, f)) if built_dt == dt => f,
-            _ => (self.make)(dt)?,
+        // built in its slot, used by reference: a filter is never moved once built
+        let filter = match &mut self.built {
+            Some((built_dt, f)) if *built_dt == dt => &*f,
+            slot => &slot.insert((dt, (self.make)(dt)?)).1,
         };
-        let result = filter.step(&self.state, z);
-        self.built = Some((dt, filter));
-        let step = result?;
+        let step = filter.step(&self.state, z)?;
         self.log_likelihood += step.log_likelihood();
-        self.state = step.posterior().clone();
+        self.state = step.into_posterior();
         Ok(())
     }
 

@@ -147,6 +147,14 @@ where
         }
     }
 
+    /// The filtered state by value ([`Step::posterior`] without a copy).
+    pub fn into_posterior(self) -> Gaussian<T, D> {
+        match self.update {
+            Some(u) => u.posterior,
+            None => self.prior,
+        }
+    }
+
     /// The log-likelihood of this step's observation (0 when it was missing).
     pub fn log_likelihood(&self) -> T
     where

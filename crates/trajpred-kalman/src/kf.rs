@@ -124,6 +124,7 @@ impl<Tr, Ob> Kf<Tr, Ob> {
     /// A KF from a linear transition (F, Q) and a linear observation (H, R), with the
     /// Joseph-form covariance update. Checks `Q` (positive semi-definite) and `R` (positive
     /// definite) once here.
+    #[inline]
     pub fn new<T: RealField + Copy, D: Dim, M: Dim>(transition: Tr, observation: Ob) -> Result<Self>
     where
         Tr: LinearTransitionModel<T, D>,

@@ -333,6 +333,18 @@ where
     D: Dim,
     DefaultAllocator: Allocator<D, D> + Allocator<D>,
 {
+    is_psd_sized(m, m.nrows())
+}
+
+/// [`is_psd`] with the shift `64 n eps max|m|` of a matrix of size `n`: the verdict on a
+/// block-diagonal matrix of size `n` whose diagonal blocks are all `m` (padded with zeros).
+#[inline(always)]
+pub(crate) fn is_psd_sized<T, D>(m: &OMatrix<T, D, D>, n: usize) -> bool
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D> + Allocator<D>,
+{
     if !all_finite(m) {
         return false;
     }
@@ -343,7 +355,6 @@ where
     if scale == T::zero() {
         return true;
     }
-    let n = m.nrows();
     let jitter = T::default_epsilon() * nalgebra::convert::<f64, T>(64.0 * n as f64) * scale;
     positive_definite_shifted(m.clone(), jitter)
 }

@@ -100,6 +100,16 @@ where
         self.process_noise().nrows()
     }
 
+    /// Checks `Q`: square and symmetric positive semi-definite (the filters call it once,
+    /// when they are built). A model whose `Q` is checked when it is made and cannot change
+    /// afterwards ([`LinearTransition`]) answers `Ok(())`, so building a filter for every
+    /// time step of a track does not check each `Q` twice.
+    fn check_process_noise(&self) -> Result<()> {
+        let q = self.process_noise();
+        check_square(q, self.state_dim(), "Q")?;
+        check_psd(q, "Q")
+    }
+
     /// The difference `a - b` of two states; override it for states holding angles (wrap the
     /// angular components). The UKF computes every mean as `x0 + sum_i w_i residual(x_i, x0)`
     /// and every spread with this function, so wrapping here gives correct angular means.
@@ -196,6 +206,15 @@ where
         self.observation_noise().nrows()
     }
 
+    /// Checks `R`: square and symmetric positive definite (the filters call it once, when
+    /// they are built). A model whose `R` is checked when it is made and cannot change
+    /// afterwards ([`LinearObservation`]) answers `Ok(())`.
+    fn check_observation_noise(&self) -> Result<()> {
+        let r = self.observation_noise();
+        check_square(r, self.observation_dim(), "R")?;
+        check_pd(r, "R")
+    }
+
     /// The difference `a - b` of two observations (the innovation is
     /// `residual(z, h(x))`); override it to wrap angles such as a bearing.
     fn observation_residual(&self, a: &OVector<T, M>, b: &OVector<T, M>) -> OVector<T, M> {
@@ -268,6 +287,9 @@ where
     fn state_dim(&self) -> usize {
         (**self).state_dim()
     }
+    fn check_process_noise(&self) -> Result<()> {
+        (**self).check_process_noise()
+    }
     fn state_residual(&self, a: &OVector<T, D>, b: &OVector<T, D>) -> OVector<T, D> {
         (**self).state_residual(a, b)
     }
@@ -329,6 +351,9 @@ where
     fn observation_dim(&self) -> usize {
         (**self).observation_dim()
     }
+    fn check_observation_noise(&self) -> Result<()> {
+        (**self).check_observation_noise()
+    }
     fn observation_residual(&self, a: &OVector<T, M>, b: &OVector<T, M>) -> OVector<T, M> {
         (**self).observation_residual(a, b)
     }
@@ -386,10 +411,6 @@ where
     Ob: Observation<T, D, M>,
     DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M>,
 {
-    let n = tr.state_dim();
-    check_square(tr.process_noise(), n, "Q")?;
-    check_psd(tr.process_noise(), "Q")?;
-    let m = ob.observation_dim();
-    check_square(ob.observation_noise(), m, "R")?;
-    check_pd(ob.observation_noise(), "R")
+    tr.check_process_noise()?;
+    ob.check_observation_noise()
 }

@@ -180,6 +180,7 @@ fn continuous_noise_block(derivatives: usize, dt: f64, q: f64) -> [[f64; 3]; 3] 
 /// assert_eq!(cv.process_noise()[(1, 1)], 6.0);
 /// # Ok::<(), trajpred_kalman::KalmanError>(())
 /// ```
+#[inline]
 pub fn kinematic_continuous<T: RealField + Copy, D: Dim>(
     layout: KinematicLayout,
     dt: f64,
@@ -198,6 +199,7 @@ where
 
 /// The kinematic transition of `layout` for `dt` with the noise block `noise(derivatives,
 /// dt, level)`, after checking `dt > 0` and the named noise level `>= 0`.
+#[inline]
 fn kinematic_noise<T, D>(
     layout: KinematicLayout,
     dt: f64,
@@ -286,6 +288,7 @@ where
     )
 }
 
+#[inline]
 fn kinematic_with<T, D>(
     layout: KinematicLayout,
     f_block: [[f64; 3]; 3],
@@ -310,7 +313,7 @@ where
             }
         }
     }
-    LinearTransition::new(f, q)
+    LinearTransition::from_kinematic_blocks(layout, f_block, q_block, f, q)
 }
 
 /// Constant velocity in `axes` axes (state `2 * axes`) for the time step `dt` and the

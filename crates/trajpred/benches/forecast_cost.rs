@@ -11,10 +11,12 @@
 //! at least 25 points). A forecast is history 20, horizon 5: 20 filter steps and 5 predictions for the
 //! KF-dynamic forms. `kf_step/static_cv4_pos2` times one predict + update of the static
 //! constant-velocity filter (`Kf` on `U4`/`U2`), so the ratio of a forecast's median to
-//! 25 x that step is the forecast's overhead (issue target: at most 3x).
+//! 25 x that step is the forecast's overhead (issue target: at most 3x);
+//! `static_ca_step_x25_per_forecast` is the same for the 6-state constant-acceleration
+//! filter (`U6`/`U2`, positions first), the step kf-ca's forecasts are made of.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use nalgebra::{Matrix2, Matrix2x4, Matrix4, U4, Vector2, Vector4};
+use nalgebra::{Matrix2, Matrix2x4, Matrix2x6, Matrix4, Matrix6, U4, U6, Vector2, Vector4, Vector6};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
@@ -24,7 +26,7 @@ use std::path::Path;
 use trajpred::dataset::{Dataset, Segmentation, load};
 use trajpred::registry::{MethodOptions, build};
 use trajpred_core::{Gaussian, Predictor, Trajectory};
-use trajpred_kalman::motion::{StateOrder, constant_velocity};
+use trajpred_kalman::motion::{StateOrder, constant_acceleration, constant_velocity};
 use trajpred_kalman::{Filter, Kf, LinearObservation};
 
 const HISTORY: usize = 20;
@@ -141,6 +143,35 @@ fn cost(c: &mut Criterion) {
                 let mut s = x0.clone();
                 for _ in 0..25 {
                     s = kf
+                        .step(&s, Some(black_box(&z)))
+                        .expect("step")
+                        .posterior()
+                        .clone();
+                }
+                black_box(&s);
+            }
+        })
+    });
+    // the same for the 6-state constant-acceleration filter that kf-ca's forecasts are made of
+    let ca = constant_acceleration::<f64, U6>(2, 3.0, 10.0, StateOrder::PositionsFirst)
+        .expect("ca");
+    let obs6 = LinearObservation::new(
+        Matrix2x6::new(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0),
+        Matrix2::identity() * 10.0,
+    )
+    .expect("observation");
+    let kf6 = Kf::new(ca, obs6).expect("kf");
+    let x6 = Gaussian::new(
+        Vector6::new(0.0, 0.0, 1.0, 0.5, 0.0, 0.0),
+        Matrix6::identity() * 100.0,
+    )
+    .expect("state");
+    g.bench_function("static_ca_step_x25_per_forecast", |b| {
+        b.iter(|| {
+            for _ in 0..histories.len() {
+                let mut s = x6.clone();
+                for _ in 0..25 {
+                    s = kf6
                         .step(&s, Some(black_box(&z)))
                         .expect("step")
                         .posterior()

@@ -3,8 +3,8 @@
 
 use crate::error::Result;
 use crate::linalg::{
-    check_dim, check_finite, check_pd, check_psd, check_square, is_static, mul, mul_tr_sym_plus,
-    mul_vec,
+    check_dim, check_finite, check_pd, check_psd, check_square, is_psd_sized, is_static, mul,
+    mul_tr_sym_plus, mul_vec,
 };
 use crate::motion::{KinematicLayout, StateOrder};
 use nalgebra::allocator::Allocator;
@@ -34,15 +34,14 @@ where
 {
     f: OMatrix<T, D, D>,
     q: OMatrix<T, D, D>,
-    /// `F = I + N` with few non-zeros in `N` (constant velocity, constant acceleration):
-    /// the non-zeros `(row, column, value)` of `N`; `None` for a general `F`.
+    /// `F = I + N` with few non-zeros in `N` outside the kinematic pattern: the non-zeros
+    /// `(row, column, value)` of `N`; `None` for a general `F` and for the kinematic pattern
+    /// (`kinematic`).
     shift: Option<Vec<(usize, usize, T)>>,
-    /// `(Q + Q^T) / 2`, for the structured propagation.
-    q_sym: OMatrix<T, D, D>,
     /// No entry of `shift` reads a row of `X` that an earlier entry updates, so the row
     /// updates `F X = X + N X` can run in place (true for the kinematic models).
     rows_in_place: bool,
-    /// `N` in the pattern of [`crate::motion::kinematic`] (the same entries as `shift`).
+    /// `N` in the pattern of [`crate::motion::kinematic`].
     kinematic: Option<Kinematic<T>>,
 }
 
@@ -214,13 +213,13 @@ where
     out
 }
 
-/// `F P F^T + Q_sym` for `F = I + N` and a symmetric `P` (see
+/// `F P F^T + (Q + Q^T) / 2` for `F = I + N` and a symmetric `P` (see
 /// [`LinearTransitionModel::propagate_covariance`] of [`LinearTransition`]).
 #[inline(always)]
 fn shift_congruence<T, D>(
     shift: &impl Shift<T>,
     p: &OMatrix<T, D, D>,
-    q_sym: &OMatrix<T, D, D>,
+    q: &OMatrix<T, D, D>,
     rows_in_place: bool,
 ) -> OMatrix<T, D, D>
 where
@@ -229,6 +228,7 @@ where
     DefaultAllocator: Allocator<D, D>,
 {
     let n = p.nrows();
+    let half = nalgebra::convert::<f64, T>(0.5);
     let mut x = p.clone();
     shift.for_each(n, |i, j, a| {
         for r in 0..n {
@@ -254,7 +254,9 @@ where
     };
     for j in 0..n {
         for i in j..n {
-            let v = out[(j, i)] + q_sym[(j, i)];
+            // `(Q + Q^T) / 2` formed here (the same value as stored, without its storage)
+            let q_sym = (q[(j, i)] + q[(i, j)]) * half;
+            let v = out[(j, i)] + q_sym;
             out[(j, i)] = v;
             out[(i, j)] = v;
         }
@@ -288,6 +290,13 @@ where
     (out.len() <= n).then_some(out)
 }
 
+/// No entry of a sparse `N` reads a row that an earlier entry updates (see `rows_in_place`).
+fn rows_update_in_place<T>(sh: &[(usize, usize, T)]) -> bool {
+    sh.iter()
+        .enumerate()
+        .all(|(k, &(_, j, _))| sh[..k].iter().all(|&(i, _, _)| i != j))
+}
+
 impl<T: RealField + Copy, D: Dim> LinearTransition<T, D>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
@@ -302,21 +311,79 @@ where
         check_square(&q, n, "Q vs F")?;
         check_finite(&f, "F")?;
         check_psd(&q, "Q")?;
-        let shift = unit_plus_sparse(&f);
-        let rows_in_place = shift.as_ref().is_some_and(|sh| {
-            sh.iter()
-                .enumerate()
-                .all(|(k, &(_, j, _))| sh[..k].iter().all(|&(i, _, _)| i != j))
-        });
-        let q_sym = (&q + q.transpose()) * nalgebra::convert::<f64, T>(0.5);
         let kinematic = kinematic_pattern(&f);
+        // the kinematic pattern needs no list of entries (and no allocation)
+        let shift = kinematic.is_none().then(|| unit_plus_sparse(&f)).flatten();
+        let rows_in_place = shift.as_deref().is_some_and(rows_update_in_place);
         Ok(LinearTransition {
             f,
             q,
             shift,
-            q_sym,
             rows_in_place,
             kinematic,
+        })
+    }
+
+    /// The kinematic transition of `layout` from its per-axis blocks (`f_block` unit upper
+    /// triangular, `q_block` symmetric), laid out in `f` and `q` by the caller
+    /// ([`crate::motion`]): the same value as [`LinearTransition::new`]`(f, q)`, built
+    /// without searching `F` for its pattern and with `Q` checked on one axis's block (the
+    /// others are copies of it), so a filter over an irregularly sampled track can build
+    /// one for every time step cheaply. Falls back to [`LinearTransition::new`] (and its
+    /// errors) when `f_block` is not unit upper triangular with finite non-zero entries above
+    /// the diagonal (no kinematic pattern: the damped velocity) or the block is not positive semi-definite.
+    #[inline]
+    pub(crate) fn from_kinematic_blocks(
+        layout: KinematicLayout,
+        f_block: [[f64; 3]; 3],
+        q_block: [[f64; 3]; 3],
+        f: OMatrix<T, D, D>,
+        q: OMatrix<T, D, D>,
+    ) -> Result<Self> {
+        let k = layout.derivatives;
+        let n = f.nrows();
+        // unit upper triangular, non-zero above the diagonal (the damped velocity is not)
+        let upper_ok = (0..k).all(|i| {
+            (0..k).all(|j| match i.cmp(&j) {
+                std::cmp::Ordering::Equal => f_block[i][j] == 1.0,
+                std::cmp::Ordering::Greater => f_block[i][j] == 0.0,
+                std::cmp::Ordering::Less => f_block[i][j].is_finite() && f_block[i][j] != 0.0,
+            })
+        });
+        let symmetric = (0..k).all(|i| (0..i).all(|j| q_block[i][j] == q_block[j][i]));
+        let shapes_ok = symmetric
+            && (2..=3).contains(&k)
+            && layout.axes >= 1
+            && n == layout.state_dim()
+            && q.nrows() == n
+            && q.ncols() == n;
+        let block = nalgebra::Matrix3::from_fn(|i, j| {
+            if i < k && j < k { nalgebra::convert::<f64, T>(q_block[i][j]) } else { T::zero() }
+        });
+        if !(upper_ok && shapes_ok && is_psd_sized::<T, nalgebra::U3>(&block, n)) {
+            return Self::new(f, q);
+        }
+        // `N = F - I`: the entries above the diagonal
+        let mut b = [[T::zero(); 3]; 3];
+        for (i, row) in f_block.iter().enumerate() {
+            for (j, &v) in row.iter().enumerate().skip(i + 1) {
+                b[i][j] = nalgebra::convert::<f64, T>(v);
+            }
+        }
+        // one axis: both orders are the same matrix, which the search reports as axis blocks
+        let positions_first = layout.order == StateOrder::PositionsFirst && layout.axes > 1;
+        let kinematic = match (k, positions_first) {
+            (2, false) => Kinematic::Velocity(KinematicShift { block: [[b[0][0], b[0][1]], [b[1][0], b[1][1]]] }),
+            (2, true) => Kinematic::VelocityPositionsFirst(KinematicShift { block: [[b[0][0], b[0][1]], [b[1][0], b[1][1]]] }),
+            (_, false) => Kinematic::Acceleration(KinematicShift { block: b }),
+            (_, true) => Kinematic::AccelerationPositionsFirst(KinematicShift { block: b }),
+        };
+        Ok(LinearTransition {
+            f,
+            q,
+            shift: None,
+            rows_in_place: false,
+            kinematic: Some(kinematic),
         })
     }
 
@@ -341,6 +408,10 @@ where
     }
     fn process_noise(&self) -> &OMatrix<T, D, D> {
         &self.q
+    }
+    /// Checked by the constructors; `Q` cannot change afterwards.
+    fn check_process_noise(&self) -> Result<()> {
+        Ok(())
     }
 }
 
@@ -390,16 +461,16 @@ where
     #[inline(always)]
     fn propagate_covariance(&self, p: &OMatrix<T, D, D>) -> OMatrix<T, D, D> {
         if let Some(kin) = &self.kinematic {
-            return with_kinematic!(kin, sh => shift_congruence(sh, p, &self.q_sym, true));
+            return with_kinematic!(kin, sh => shift_congruence(sh, p, &self.q, true));
         }
         let Some(shift) = &self.shift else {
             return mul_tr_sym_plus(&mul(&self.f, p), &self.f, &self.q);
         };
-        shift_congruence(&SparseShift(shift), p, &self.q_sym, self.rows_in_place)
+        shift_congruence(&SparseShift(shift), p, &self.q, self.rows_in_place)
     }
 
     fn has_structured_propagation(&self) -> bool {
-        self.shift.is_some()
+        self.shift.is_some() || self.kinematic.is_some()
     }
 
     /// Every path mirrors: the sparse and kinematic updates and the dense products (static
@@ -423,12 +494,13 @@ where
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinearObservation<T: RealField, D: Dim, M: Dim>
 where
-    DefaultAllocator: Allocator<M, D> + Allocator<M, M>,
+    DefaultAllocator: Allocator<M> + Allocator<M, D> + Allocator<M, M>,
 {
     h: OMatrix<T, M, D>,
     r: OMatrix<T, M, M>,
-    /// The state component each row of `H` selects, when every row is a unit vector.
-    selection: Option<Vec<usize>>,
+    /// The state component each row of `H` selects, when every row is a unit vector (a
+    /// vector of the observation's size: no heap for static sizes, so a clone is a copy).
+    selection: Option<OVector<usize, M>>,
 }
 
 impl<T: RealField + Copy, D: Dim, M: Dim> LinearObservation<T, D, M>
@@ -455,7 +527,8 @@ where
                     None
                 }
             })
-            .collect::<Option<Vec<usize>>>();
+            .collect::<Option<Vec<usize>>>()
+            .map(|idx| OVector::<usize, M>::from_iterator_generic(h.shape_generic().0, nalgebra::Const::<1>, idx));
         Ok(LinearObservation { h, r, selection })
     }
 
@@ -482,6 +555,10 @@ where
     fn observation_noise(&self) -> &OMatrix<T, M, M> {
         &self.r
     }
+    /// Checked by [`LinearObservation::new`]; `R` cannot change afterwards.
+    fn check_observation_noise(&self) -> Result<()> {
+        Ok(())
+    }
 }
 
 impl<T: RealField + Copy, D: Dim, M: Dim> ObservationJacobian<T, D, M>
@@ -505,7 +582,7 @@ where
         &self.h
     }
     fn selected_components(&self) -> Option<&[usize]> {
-        self.selection.as_deref()
+        self.selection.as_ref().map(|idx| idx.as_slice())
     }
 }
 
@@ -577,14 +654,16 @@ mod tests {
                     Kinematic::AccelerationPositionsFirst(_) => (3, true),
                 };
                 assert_eq!(found, (derivatives, positions_first), "n = {n}");
-                let sparse = SparseShift(tr.shift.as_deref().expect("sparse"));
-                assert!(tr.rows_in_place);
+                assert!(tr.shift.is_none(), "the kinematic pattern keeps no list");
+                let entries = unit_plus_sparse(&tr.f).expect("sparse");
+                let sparse = SparseShift(&entries);
+                assert!(rows_update_in_place(&entries));
                 let p = spd(d);
                 let x = OVector::<f64, D>::from_fn_generic(d, Const::<1>, |i, _| {
                     ((5 * i + 2) as f64).cos() * 3.1
                 });
                 let fast = tr.propagate_covariance(&p);
-                let general = shift_congruence(&sparse, &p, &tr.q_sym, true);
+                let general = shift_congruence(&sparse, &p, &tr.q, true);
                 assert!(
                     same_bits(&fast, &general),
                     "F P F^T + Q, n = {n}\n{fast}{general}"
@@ -594,7 +673,7 @@ mod tests {
                     same_bits(&fast_mean, &shift_mean(&sparse, &x)),
                     "F x, n = {n}"
                 );
-                let dense = &tr.f * &p * tr.f.transpose() + &tr.q_sym;
+                let dense = &tr.f * &p * tr.f.transpose() + (&tr.q + tr.q.transpose()) * 0.5;
                 for (a, b) in fast.iter().zip(dense.iter()) {
                     assert!((a - b).abs() <= 1e-13 * b.abs().max(1.0), "{a} vs {b}");
                 }

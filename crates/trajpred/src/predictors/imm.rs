@@ -20,7 +20,7 @@ use nalgebra::{SMatrix, SVector, U2, U7, Vector2};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use trajpred_core::{Error, Forecast, Gaussian, Predictor, Result, Trajectory};
-use trajpred_kalman::driver::{TimeStepFilter, drive};
+use trajpred_kalman::driver::{TimeStepFilter, drive_each};
 use trajpred_kalman::imm::{
     Imm, ImmState, TimedImm, coordinated_turn_continuous, uniform_switching,
 };
@@ -198,7 +198,7 @@ impl ImmPredictor {
                 Some(Vector2::new(q[0], q[1]))
             })
             .collect();
-        drive(&mut f, history.times(), &z, |_, _| Ok(())).map_err(kalman)?;
+        drive_each(&mut f, history.times(), &z, |_, _| Ok(())).map_err(kalman)?;
         Ok(f)
     }
 

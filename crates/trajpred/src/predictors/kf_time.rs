@@ -10,7 +10,7 @@ use nalgebra::{Const, DefaultAllocator, Dim, Dyn, OMatrix, OVector, U1, U2, U3, 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use trajpred_core::{Error, Forecast, Gaussian, Predictor, Result, Trajectory};
-use trajpred_kalman::driver::{TimeStepFilter, Timed, drive};
+use trajpred_kalman::driver::{TimeStepFilter, Timed, drive_each};
 use trajpred_kalman::motion::{
     KinematicLayout, StateOrder, damped_velocity, kinematic_continuous, position_observation,
 };
@@ -169,13 +169,14 @@ impl KfTime {
         let layout = self.layout(d)?;
         let (nd, md) = (N::from_usize(layout.state_dim()), M::from_usize(d));
         let tau = self.params.time_constant;
+        // the observation is the same at every step: built (and checked) once
+        let obs = position_observation::<f64, N, M>(layout, r).map_err(kalman)?;
         let make = move |dt: f64| {
             let tr = match tau {
                 Some(tau) => damped_velocity::<f64, N>(layout, dt, q, tau)?,
                 None => kinematic_continuous::<f64, N>(layout, dt, q)?,
             };
-            let obs = position_observation::<f64, N, M>(layout, r)?;
-            Kf::new(tr, obs)
+            Kf::new(tr, obs.clone())
         };
         let first = history.point(0);
         let mut mean = OVector::<f64, N>::zeros_generic(nd, Const::<1>);
@@ -200,7 +201,7 @@ impl KfTime {
                 ))
             })
             .collect();
-        drive(&mut f, history.times(), &z, |_, _| Ok(())).map_err(kalman)?;
+        drive_each(&mut f, history.times(), &z, |_, _| Ok(())).map_err(kalman)?;
         Ok(f)
     }
 

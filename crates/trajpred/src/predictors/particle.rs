@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use trajpred_core::{
     Error, Forecast, Gaussian, Predictor, Result, Trajectory, check_forecast_args,
 };
-use trajpred_kalman::driver::{TimeStepFilter, drive};
+use trajpred_kalman::driver::{TimeStepFilter, drive_each};
 use trajpred_kalman::motion::{KinematicLayout, StateOrder, kinematic_continuous};
 use trajpred_kalman::{LinearObservation, MerweSigmaPoints};
 use trajpred_particle::driver::TimedParticles;
@@ -118,7 +118,7 @@ fn run<F: TimeStepFilter<f64, Dyn, Dyn>>(
     z: &[Option<DVector<f64>>],
     offsets: &[f64],
 ) -> std::result::Result<Vec<Gaussian<f64, Dyn>>, F::Error> {
-    drive(filter, times, z, |_, _| Ok(()))?;
+    drive_each(filter, times, z, |_, _| Ok(()))?;
     filter.forecast_at(offsets)
 }
 
