@@ -77,7 +77,13 @@ fn the_damped_velocity_is_not_taken_for_the_kinematic_pattern() {
 #[test]
 fn a_bad_step_or_noise_is_still_a_typed_error() {
     let layout = KinematicLayout::new(2, 3, StateOrder::PositionsFirst).expect("layout");
-    for (dt, q) in [(f64::NAN, 1.0), (0.0, 1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, f64::NAN)] {
+    for (dt, q) in [
+        (f64::NAN, 1.0),
+        (0.0, 1.0),
+        (-1.0, 1.0),
+        (1.0, -1.0),
+        (1.0, f64::NAN),
+    ] {
         let e = kinematic_continuous::<f64, U6>(layout, dt, q).expect_err("rejected");
         assert!(
             matches!(

@@ -15,8 +15,9 @@
 //! `static_ca_step_x25_per_forecast` is the same for the 6-state constant-acceleration
 //! filter (`U6`/`U2`, positions first), the step kf-ca's forecasts are made of.
 
-use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use nalgebra::{Matrix2, Matrix2x4, Matrix2x6, Matrix4, Matrix6, U4, U6, Vector2, Vector4, Vector6};
+use criterion::measurement::WallTime;
+use criterion::{BenchmarkGroup, Criterion, Throughput, criterion_group, criterion_main};
+use nalgebra::{DefaultAllocator, DimName, OMatrix, OVector, U2, U4, U6, Vector2};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
@@ -26,8 +27,8 @@ use std::path::Path;
 use trajpred::dataset::{Dataset, Segmentation, load};
 use trajpred::registry::{MethodOptions, build};
 use trajpred_core::{Gaussian, Predictor, Trajectory};
-use trajpred_kalman::motion::{StateOrder, constant_acceleration, constant_velocity};
-use trajpred_kalman::{Filter, Kf, LinearObservation};
+use trajpred_kalman::motion::{KinematicLayout, StateOrder, kinematic, position_observation};
+use trajpred_kalman::{Filter, FilterAllocator, Kf};
 
 const HISTORY: usize = 20;
 const HORIZON: usize = 5;
@@ -122,66 +123,52 @@ fn cost(c: &mut Criterion) {
             })
         });
     }
-    // the static step the forecasts are made of, 25 per forecast
-    let cv = constant_velocity::<f64, U4>(2, 3.0, 10.0, StateOrder::PositionsFirst).expect("cv");
-    let obs = LinearObservation::new(
-        Matrix2x4::new(1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0),
-        Matrix2::identity() * 10.0,
-    )
-    .expect("observation");
-    let kf = Kf::new(cv, obs).expect("kf");
-    let x0 = Gaussian::new(
-        Vector4::new(0.0, 0.0, 1.0, 0.5),
-        Matrix4::identity() * 100.0,
-    )
-    .expect("state");
-    let z = Vector2::new(1.0, 2.0);
+    // the static steps the forecasts are made of, 25 per forecast: constant velocity for
+    // the KF-dynamic forms and kf-cv, constant acceleration (6 states) for kf-ca
     g.throughput(Throughput::Elements((25 * histories.len()) as u64));
-    g.bench_function("static_step_x25_per_forecast", |b| {
+    static_steps::<U4>(&mut g, "static_step_x25_per_forecast", 2, histories.len());
+    static_steps::<U6>(
+        &mut g,
+        "static_ca_step_x25_per_forecast",
+        3,
+        histories.len(),
+    );
+    g.finish();
+}
+
+/// 25 predict + update steps of the static 2-D kinematic filter with `derivatives` per axis
+/// (positions first, positions observed with `R = 10 I`, discrete white noise 10, 3 s),
+/// from a vague state, for each of `histories` forecasts.
+fn static_steps<N: DimName>(
+    g: &mut BenchmarkGroup<'_, WallTime>,
+    name: &str,
+    derivatives: usize,
+    histories: usize,
+) where
+    DefaultAllocator: FilterAllocator<N, U2>,
+{
+    let layout = KinematicLayout::new(2, derivatives, StateOrder::PositionsFirst).expect("layout");
+    let tr = kinematic::<f64, N>(layout, 3.0, 10.0).expect("transition");
+    let obs = position_observation::<f64, N, U2>(layout, 10.0).expect("observation");
+    let kf = Kf::new(tr, obs).expect("kf");
+    let mut mean = OVector::<f64, N>::zeros();
+    (mean[2], mean[3]) = (1.0, 0.5);
+    let x0 = Gaussian::new(mean, OMatrix::<f64, N, N>::identity() * 100.0).expect("state");
+    let z = Vector2::new(1.0, 2.0);
+    g.bench_function(name, |b| {
         b.iter(|| {
-            for _ in 0..histories.len() {
+            for _ in 0..histories {
                 let mut s = x0.clone();
                 for _ in 0..25 {
                     s = kf
                         .step(&s, Some(black_box(&z)))
                         .expect("step")
-                        .posterior()
-                        .clone();
+                        .into_posterior();
                 }
                 black_box(&s);
             }
         })
     });
-    // the same for the 6-state constant-acceleration filter that kf-ca's forecasts are made of
-    let ca = constant_acceleration::<f64, U6>(2, 3.0, 10.0, StateOrder::PositionsFirst)
-        .expect("ca");
-    let obs6 = LinearObservation::new(
-        Matrix2x6::new(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0),
-        Matrix2::identity() * 10.0,
-    )
-    .expect("observation");
-    let kf6 = Kf::new(ca, obs6).expect("kf");
-    let x6 = Gaussian::new(
-        Vector6::new(0.0, 0.0, 1.0, 0.5, 0.0, 0.0),
-        Matrix6::identity() * 100.0,
-    )
-    .expect("state");
-    g.bench_function("static_ca_step_x25_per_forecast", |b| {
-        b.iter(|| {
-            for _ in 0..histories.len() {
-                let mut s = x6.clone();
-                for _ in 0..25 {
-                    s = kf6
-                        .step(&s, Some(black_box(&z)))
-                        .expect("step")
-                        .posterior()
-                        .clone();
-                }
-                black_box(&s);
-            }
-        })
-    });
-    g.finish();
 }
 
 criterion_group!(benches, cost);

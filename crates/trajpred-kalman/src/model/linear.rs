@@ -358,7 +358,11 @@ where
             && q.nrows() == n
             && q.ncols() == n;
         let block = nalgebra::Matrix3::from_fn(|i, j| {
-            if i < k && j < k { nalgebra::convert::<f64, T>(q_block[i][j]) } else { T::zero() }
+            if i < k && j < k {
+                nalgebra::convert::<f64, T>(q_block[i][j])
+            } else {
+                T::zero()
+            }
         });
         if !(upper_ok && shapes_ok && is_psd_sized::<T, nalgebra::U3>(&block, n)) {
             return Self::new(f, q);
@@ -373,8 +377,12 @@ where
         // one axis: both orders are the same matrix, which the search reports as axis blocks
         let positions_first = layout.order == StateOrder::PositionsFirst && layout.axes > 1;
         let kinematic = match (k, positions_first) {
-            (2, false) => Kinematic::Velocity(KinematicShift { block: [[b[0][0], b[0][1]], [b[1][0], b[1][1]]] }),
-            (2, true) => Kinematic::VelocityPositionsFirst(KinematicShift { block: [[b[0][0], b[0][1]], [b[1][0], b[1][1]]] }),
+            (2, false) => Kinematic::Velocity(KinematicShift {
+                block: [[b[0][0], b[0][1]], [b[1][0], b[1][1]]],
+            }),
+            (2, true) => Kinematic::VelocityPositionsFirst(KinematicShift {
+                block: [[b[0][0], b[0][1]], [b[1][0], b[1][1]]],
+            }),
             (_, false) => Kinematic::Acceleration(KinematicShift { block: b }),
             (_, true) => Kinematic::AccelerationPositionsFirst(KinematicShift { block: b }),
         };
@@ -528,7 +536,13 @@ where
                 }
             })
             .collect::<Option<Vec<usize>>>()
-            .map(|idx| OVector::<usize, M>::from_iterator_generic(h.shape_generic().0, nalgebra::Const::<1>, idx));
+            .map(|idx| {
+                OVector::<usize, M>::from_iterator_generic(
+                    h.shape_generic().0,
+                    nalgebra::Const::<1>,
+                    idx,
+                )
+            });
         Ok(LinearObservation { h, r, selection })
     }
 
