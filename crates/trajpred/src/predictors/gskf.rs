@@ -11,7 +11,6 @@
 //! `i` is the most recent one observable at time `i`: `V_t = x_i - X_hat^0_t(i - t)`. Nothing
 //! after the origin is used.
 
-use super::auto::{fold_of_trajectories, fold_split};
 use super::fitted::{At, exact, exact_matrix, exact_vec};
 use super::invalid;
 use nalgebra::{DMatrix, DVector, Dyn};
@@ -23,6 +22,7 @@ use trajpred_core::{
 use trajpred_kalman::{Ikf, Innovation, LinearObservation, LinearTransition};
 use trajpred_sparse::{GroupSparseCoder, Lars};
 
+mod correct;
 mod steps;
 
 /// Parameters of [`Gsc`] and [`Gskf`].
@@ -563,86 +563,6 @@ impl Gskf {
             })
             .collect()
     }
-
-    /// Chooses per axis between the plain GSC and each `q` of the grid by the mean absolute
-    /// error pooled over [`CV_FOLDS`] folds by group (the leaderboard's measure is a mean of
-    /// distances, and squares would let one wild held-out user decide): the GSC fitted on
-    /// the other folds, scored on the held-out one's rolling origins. Returns the filters refitted on all of `train`
-    /// and what was chosen, in words.
-    fn fit_cross_validated(
-        &self,
-        train: &[Trajectory],
-        groups: &[usize],
-        steps: &[Option<usize>],
-    ) -> Result<(Vec<AxisFilter>, String)> {
-        let (fold, k) = fold_of_trajectories(groups, CV_FOLDS, 0)?;
-        let needed = self.params.window + self.params.horizons + 1;
-        let grid = &self.params.q_grid;
-        // per axis, per option (0: no correction, 1..: the grid): absolute errors and count
-        let mut sae: Vec<Vec<(f64, usize)>> = Vec::new();
-        for f in 0..k {
-            let (fit, _, held) = fold_split(train, groups, &fold, f);
-            let Ok(coders) = fit_axes(&self.params, &fit, steps) else {
-                continue;
-            };
-            sae.resize(coders.len(), vec![(0.0, 0); grid.len() + 1]);
-            for (a, gsc) in coders.into_iter().enumerate() {
-                let series = axis_series(&held, a, needed);
-                let scale = mean_residual_variance(&gsc);
-                for (o, g) in std::iter::once(None)
-                    .chain(grid.iter().map(Some))
-                    .enumerate()
-                {
-                    let filter = match g {
-                        None => AxisFilter::plain(gsc.clone()),
-                        Some(&g) => AxisFilter::new(gsc.clone(), (g * scale).max(1e-300)),
-                    };
-                    let Ok(filter) = filter else {
-                        sae[a][o].0 = f64::INFINITY;
-                        continue;
-                    };
-                    let (_, e, n) = errors(&filter, &series)?;
-                    sae[a][o].0 += e;
-                    sae[a][o].1 += n;
-                }
-            }
-        }
-        let coders = fit_axes(&self.params, train, steps)?;
-        let mut said = format!("chosen per axis by {k}-fold cross-validation by group");
-        let mut axes = Vec::with_capacity(coders.len());
-        for (a, gsc) in coders.into_iter().enumerate() {
-            let scale = mean_residual_variance(&gsc);
-            let mae = |o: usize| {
-                sae.get(a)
-                    .map(|row| row[o])
-                    .filter(|&(e, n)| n > 0 && e.is_finite())
-                    .map_or(f64::INFINITY, |(e, n)| e / n as f64)
-            };
-            let best = (0..=grid.len()).fold(0, |b, o| if mae(o) < mae(b) { o } else { b });
-            let shown = |e: f64| match e.is_finite() {
-                true => format!("{e:.4e}"),
-                false => "failed in a fold".into(),
-            };
-            let _ = write!(
-                said,
-                "; held-out mean absolute error, axis {a}: GSC alone {}",
-                shown(mae(0))
-            );
-            for (j, g) in grid.iter().enumerate() {
-                let _ = write!(said, ", q = {:.3e}: {}", g * scale, shown(mae(j + 1)));
-            }
-            let filter = if best == 0 {
-                let _ = write!(said, " -> no correction");
-                AxisFilter::plain(gsc)?
-            } else {
-                let q = (grid[best - 1] * scale).max(1e-300);
-                let _ = write!(said, " -> q = {q:.3e}");
-                AxisFilter::new(gsc, q)?
-            };
-            axes.push(filter);
-        }
-        Ok((axes, said))
-    }
 }
 
 /// Folds of [`Gskf`]'s and [`Gsc`]'s cross-validations by group.
@@ -685,7 +605,7 @@ impl Predictor for Gskf {
                 true => steps::choose_steps(&self.params, train, groups)?,
                 false => (Vec::new(), "full LAR paths".to_string()),
             };
-            let (axes, said) = self.fit_cross_validated(train, groups, &steps)?;
+            let (axes, said) = correct::choose(&self.params, train, groups, &steps)?;
             self.axes = axes;
             self.summary = Some(format!("{said}; {steps_said}"));
         }
