@@ -70,7 +70,9 @@ fn cv(dt: f64, q: f64, r: f64) -> Result<CvKf, KalmanError> {
 }
 
 /// The fixture's filters (one per step), initial state and observations after the first.
-fn setup(fx: &Value) -> (Vec<CvKf>, Gaussian<f64, U4>, Vec<Option<Vector2<f64>>>) {
+type Case = (Vec<CvKf>, Gaussian<f64, U4>, Vec<Option<Vector2<f64>>>);
+
+fn setup(fx: &Value) -> Case {
     let (q, r) = (num(&fx["q"]), num(&fx["r"]));
     let times: Vec<f64> = fx["times"]
         .as_array()
