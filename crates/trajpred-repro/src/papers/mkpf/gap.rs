@@ -240,11 +240,6 @@ pub fn seeded_runs(
         .collect()
 }
 
-/// The noise of `motion` chosen for `setup` (the kept frames' likelihood, as Tables 1b, 2b).
-pub fn noise_for(flight: &Flight, setup: &Setup, motion: Motion) -> Result<Noise> {
-    choose_noise(flight, setup, motion)
-}
-
 /// Mean of each measure over runs, in percent (RMSE in metres), with the sample sd over runs of
 /// the relative error and of the RMSE, and the mean wall time.
 fn summary(key: String, runs: &[Run], location: [f64; 2], paper: f64) -> Result<Row> {
@@ -371,7 +366,7 @@ pub(super) fn tables(
             ..setup.clone()
         };
         for (m, fwd) in [(Motion::Cv, Forward::Kf), (Motion::Ct, Forward::Ukf)] {
-            let q = noise_for(flight, &s, m)?;
+            let q = choose_noise(flight, &s, m)?;
             let fc = seeded_runs(flight, &s, m, &q, Method::Ukf, seeds)?;
             let frames = fc.first().map(|r| r.frames.clone()).unwrap_or_default();
             let sm = run_smoother(flight, &s, m, &q, fwd, &frames)?;
