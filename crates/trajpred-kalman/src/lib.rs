@@ -46,4 +46,5 @@ pub use imm::{Imm, ImmState, ImmStep, TimedImm};
 pub use predictor::MultiStep;
 pub mod augmented;
 pub mod sampling;
+pub mod smoother;
 pub use augmented::{AugmentedUkf, NoisyObservation, NoisyTransition};

@@ -4,19 +4,22 @@
 //! MKPF) and in metres. Compared: the MKPF, the bootstrap PF with the same particle count
 //! (and ten times as many), the UKF and the EKF, each with a constant-velocity and a
 //! coordinated-turn model. A synthetic coordinated-turn flight runs the same protocol without
-//! data. The paper's tables, figures and claims are in its spec (`papers/mkpf.toml`); this
+//! data. On the real flight, Tables 3-5 ([`gap`]) decompose the gap to the paper's figure
+//! (the measure at the paper's location, a smoother, the particle count, the observation
+//! noise). The paper's tables, figures and claims are in its spec (`papers/mkpf.toml`); this
 //! module runs the experiment ([`experiment`]) and hands the numbers to the runner.
 //! `docs/mkpf.md` says what the paper left open and what we chose.
 
 pub mod experiment;
 mod flight;
+pub mod gap;
 mod models;
 
 use crate::report::{Figure, PaperResult, Value};
 use crate::runner::{Computed, Row, assemble};
 use crate::{Context, Paper, Result};
 use experiment::{
-    Flight, Method, Motion, Noise, Run, Setup, choose_noise, kept_frames, load_flight, run_method,
+    Flight, Method, Motion, Noise, Run, Setup, choose_noise, kept_frames, load_flight,
     synthetic_flight,
 };
 use serde::Deserialize;
@@ -89,6 +92,13 @@ fn summary_row(r: &MethodRuns) -> Result<Row> {
     )
 }
 
+/// The seeds of `n` runs from the base seed.
+fn seeds_from(base: u64, n: usize) -> Vec<u64> {
+    (0..n)
+        .map(|i| base.wrapping_add((i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)))
+        .collect()
+}
+
 /// Everything run on one flight.
 #[derive(Debug, Clone)]
 pub struct FlightResult {
@@ -116,19 +126,14 @@ fn run_flight(
         let q = choose_noise(&flight, setup, motion)?;
         noise.push((motion, q));
         for (key, method) in methods {
-            let n = if method.particles().is_some() {
-                seeds
-            } else {
-                1
-            };
-            let runs = (0..n)
-                .map(|i| {
-                    let seed = ctx
-                        .seed
-                        .wrapping_add((i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
-                    run_method(&flight, setup, motion, &q, *method, seed)
-                })
-                .collect::<Result<Vec<_>>>()?;
+            let runs = gap::seeded_runs(
+                &flight,
+                setup,
+                motion,
+                &q,
+                *method,
+                &seeds_from(ctx.seed, seeds),
+            )?;
             rows.push(MethodRuns {
                 motion,
                 key: key.clone(),
@@ -288,6 +293,11 @@ pub fn run(ctx: &Context) -> Result<PaperResult> {
         out.data.push(choice.description.clone());
         let real = run_flight(ctx, &setup, &methods, choice.flight, budget.seeds, "ADS-B")?;
         tables(&mut out, "table1", "table1_noise", &real, &setup)?;
+        let paper = spec
+            .paper_figure("table1", "paper", "cv-mkpf")
+            .ok_or_else(|| experiment::experiment_err("no paper figure for table1/cv-mkpf"))?;
+        let seeds = seeds_from(ctx.seed, budget.seeds);
+        gap::tables(&mut out, &real, &setup, &seeds, paper)?;
         out.figures.extend(figures(
             "fig_flight",
             "ADS-B flight",

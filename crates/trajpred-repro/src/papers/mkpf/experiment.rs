@@ -164,6 +164,13 @@ pub struct Setup {
     pub particles: usize,
     /// Particles of the larger bootstrap PF.
     pub bootstrap_particles: usize,
+    /// Where the flight's east-north errors are placed to compare with the paper's relative
+    /// error (latitude, longitude, degrees): in the paper's region.
+    pub paper_location: [f64; 2],
+    /// The MKPF's particle counts compared (Table 4).
+    pub particle_counts: Vec<usize>,
+    /// The observation noise sds the filters are run with (Table 5), metres per axis.
+    pub observation_sds: Vec<f64>,
 }
 
 impl Setup {
