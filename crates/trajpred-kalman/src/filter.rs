@@ -397,37 +397,7 @@ where
     /// gains, the last one zero; here there are `N - 1`, none for the last state, which
     /// the smoother leaves as filtered). Errors with [`trajpred_core::Error::Empty`] for no states.
     fn smooth_with_gains(&self, filtered: &[Gaussian<T, D>]) -> Result<RtsSmoothed<T, D>> {
-        if filtered.is_empty() {
-            return Err(CoreError::Empty {
-                what: "filtered states",
-            }
-            .into());
-        }
-        let mut out: Vec<Gaussian<T, D>> = filtered.to_vec();
-        let mut gains = Vec::with_capacity(filtered.len() - 1);
-        for k in (0..filtered.len().saturating_sub(1)).rev() {
-            let (pred, cross) = self.prediction_with_cross_covariance(&filtered[k])?;
-            let factors = ldl(pred.covariance.clone(), "P(k+1|k)")?;
-            // G^T = P(k+1|k)^-1 C^T, since P(k+1|k) is symmetric
-            let mut gt = cross.transpose();
-            factors.solve_mut(&mut gt);
-            let gain = gt.transpose();
-            let next = &out[k + 1];
-            let dx = &next.mean - &pred.mean;
-            let dp = &next.covariance - &pred.covariance;
-            let mean = &filtered[k].mean + &gain * dx;
-            let mut cov = &filtered[k].covariance + &gain * dp * gain.transpose();
-            symmetrise(&mut cov);
-            check_finite(&mean, "smoothed mean")?;
-            check_finite(&cov, "smoothed covariance")?;
-            out[k] = Gaussian {
-                mean,
-                covariance: cov,
-            };
-            gains.push(gain);
-        }
-        gains.reverse();
-        Ok(RtsSmoothed { states: out, gains })
+        rts_backward(filtered, |_| self)
     }
 
     /// Filters and smooths a sequence in one call.
@@ -440,6 +410,55 @@ where
         let filtered: Vec<Gaussian<T, D>> = steps.iter().map(|s| s.posterior().clone()).collect();
         self.smooth(&filtered)
     }
+}
+
+/// The backward pass of the RTS smoother over `filtered` (time order), with the filter
+/// `filter_at(k)` of the step from state `k` to `k + 1`: one filter for every step
+/// ([`Smoother::smooth_with_gains`]) or one per step
+/// ([`smooth_steps`](crate::smoother::smooth_steps)). Errors with
+/// [`trajpred_core::Error::Empty`] for no states.
+pub(crate) fn rts_backward<'a, T, D, M, S>(
+    filtered: &[Gaussian<T, D>],
+    filter_at: impl Fn(usize) -> &'a S,
+) -> Result<RtsSmoothed<T, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    M: Dim,
+    S: Smoother<T, D, M> + ?Sized + 'a,
+    DefaultAllocator: FilterAllocator<D, M>,
+{
+    if filtered.is_empty() {
+        return Err(CoreError::Empty {
+            what: "filtered states",
+        }
+        .into());
+    }
+    let mut out: Vec<Gaussian<T, D>> = filtered.to_vec();
+    let mut gains = Vec::with_capacity(filtered.len() - 1);
+    for k in (0..filtered.len() - 1).rev() {
+        let (pred, cross) = filter_at(k).prediction_with_cross_covariance(&filtered[k])?;
+        let factors = ldl(pred.covariance.clone(), "P(k+1|k)")?;
+        // G^T = P(k+1|k)^-1 C^T, since P(k+1|k) is symmetric
+        let mut gt = cross.transpose();
+        factors.solve_mut(&mut gt);
+        let gain = gt.transpose();
+        let next = &out[k + 1];
+        let dx = &next.mean - &pred.mean;
+        let dp = &next.covariance - &pred.covariance;
+        let mean = &filtered[k].mean + &gain * dx;
+        let mut cov = &filtered[k].covariance + &gain * dp * gain.transpose();
+        symmetrise(&mut cov);
+        check_finite(&mean, "smoothed mean")?;
+        check_finite(&cov, "smoothed covariance")?;
+        out[k] = Gaussian {
+            mean,
+            covariance: cov,
+        };
+        gains.push(gain);
+    }
+    gains.reverse();
+    Ok(RtsSmoothed { states: out, gains })
 }
 
 /// The prediction of a linearised model: mean given, `P' = F P F^T + Q`, symmetrised.

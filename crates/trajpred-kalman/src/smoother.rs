@@ -14,8 +14,7 @@
 
 use crate::alloc::FilterAllocator;
 use crate::error::Result;
-use crate::filter::{RtsSmoothed, Smoother, Step};
-use crate::linalg::{check_finite, ldl, symmetrise};
+use crate::filter::{RtsSmoothed, Smoother, Step, rts_backward};
 use nalgebra::{DefaultAllocator, Dim, OVector, RealField};
 use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
@@ -69,27 +68,7 @@ where
         }
         .into());
     }
-    let mut states: Vec<Gaussian<T, D>> = filtered.to_vec();
-    let mut gains = Vec::with_capacity(filters.len());
-    for (k, filter) in filters.iter().enumerate().rev() {
-        let (pred, cross) = filter.prediction_with_cross_covariance(&filtered[k])?;
-        let factors = ldl(pred.covariance.clone(), "P(k+1|k)")?;
-        // G^T = P(k+1|k)^-1 C^T, P(k+1|k) being symmetric
-        let mut gt = cross.transpose();
-        factors.solve_mut(&mut gt);
-        let gain = gt.transpose();
-        let next = &states[k + 1];
-        let mean = &filtered[k].mean + &gain * (&next.mean - &pred.mean);
-        let mut covariance = &filtered[k].covariance
-            + &gain * (&next.covariance - &pred.covariance) * gain.transpose();
-        symmetrise(&mut covariance);
-        check_finite(&mean, "smoothed mean")?;
-        check_finite(&covariance, "smoothed covariance")?;
-        states[k] = Gaussian { mean, covariance };
-        gains.push(gain);
-    }
-    gains.reverse();
-    Ok(RtsSmoothed { states, gains })
+    rts_backward(filtered, |k| &filters[k])
 }
 
 /// Filters forward from `initial` (the state at time point 0) with `filters[k]` over the step
