@@ -6,6 +6,8 @@
 //! fixtures (`tests/filterpy_fixtures.rs`): the two implementations agree to rounding, any
 //! modelling difference (a wrong `Q` block, a skipped step, the wrong interval) is far larger.
 
+mod common;
+use common::{num, nums};
 use nalgebra::{DVector, Matrix2, Matrix2x4, Matrix4, U4, Vector2, Vector4};
 use serde_json::Value;
 use trajpred_core::Error as CoreError;
@@ -17,22 +19,11 @@ use trajpred_kalman::{KalmanError, Kf, LinearObservation, Transition};
 const TOL: f64 = 1e-9;
 
 fn fixture() -> Value {
-    let path = format!(
-        "{}/../../fixtures/kalman/timed_cv.json",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    serde_json::from_str(&std::fs::read_to_string(path).expect("fixture")).expect("JSON")
-}
-
-fn num(v: &Value) -> f64 {
-    v.as_f64().expect("number")
+    common::fixture("timed_cv.json")
 }
 
 fn close(ours: f64, theirs: f64, what: &str) {
-    assert!(
-        (ours - theirs).abs() <= TOL * theirs.abs().max(1.0),
-        "{what}: ours {ours}, filterpy {theirs}"
-    );
+    common::close_rel(ours, theirs, TOL, what);
 }
 
 fn layout(derivatives: usize) -> KinematicLayout {
@@ -76,12 +67,7 @@ fn cv_filter(q: f64, r: f64) -> impl Fn(f64) -> Result<CvKf, KalmanError> {
 fn the_driver_over_irregular_times_matches_filterpy() {
     let fx = fixture();
     let (q, r) = (num(&fx["q"]), num(&fx["r"]));
-    let times: Vec<f64> = fx["times"]
-        .as_array()
-        .expect("times")
-        .iter()
-        .map(num)
-        .collect();
+    let times = nums(&fx["times"]);
     let z: Vec<Option<Vector2<f64>>> = fx["observations"]
         .as_array()
         .expect("observations")

@@ -68,7 +68,7 @@ fn the_damped_velocity_is_not_taken_for_the_kinematic_pattern() {
         let layout = KinematicLayout::new(2, 2, order).expect("layout");
         for dt in STEPS {
             let tr = damped_velocity::<f64, U4>(layout, dt, 0.5, 30.0).expect("damped");
-            let general = LinearTransition::new(tr.f().clone(), tr.q().clone()).expect("valid");
+            let general = LinearTransition::new(*tr.f(), *tr.q()).expect("valid");
             assert_eq!(tr, general, "dt = {dt}");
         }
     }

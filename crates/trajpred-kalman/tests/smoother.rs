@@ -11,6 +11,8 @@
 //! only, while a modelling error is far larger (using the first step's filter for every step
 //! moves the first smoothed position by 26 m).
 
+mod common;
+use common::{num, nums};
 use nalgebra::{Matrix2, Matrix2x4, Matrix4, U2, U4, Vector2, Vector4};
 use serde_json::Value;
 use trajpred_core::Error as CoreError;
@@ -23,22 +25,11 @@ const TOL: f64 = 1e-10;
 type CvKf = Kf<LinearTransition<f64, U4>, LinearObservation<f64, U4, U2>>;
 
 fn fixture() -> Value {
-    let path = format!(
-        "{}/../../fixtures/kalman/rts_varying.json",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    serde_json::from_str(&std::fs::read_to_string(path).expect("fixture")).expect("JSON")
-}
-
-fn num(v: &Value) -> f64 {
-    v.as_f64().expect("number")
+    common::fixture("rts_varying.json")
 }
 
 fn close(ours: f64, theirs: f64, what: &str) {
-    assert!(
-        (ours - theirs).abs() <= TOL * theirs.abs().max(1.0),
-        "{what}: ours {ours}, filterpy {theirs}"
-    );
+    common::close_rel(ours, theirs, TOL, what);
 }
 
 fn vec4(v: &Value) -> Vector4<f64> {
@@ -74,12 +65,7 @@ type Case = (Vec<CvKf>, Gaussian<f64, U4>, Vec<Option<Vector2<f64>>>);
 
 fn setup(fx: &Value) -> Case {
     let (q, r) = (num(&fx["q"]), num(&fx["r"]));
-    let times: Vec<f64> = fx["times"]
-        .as_array()
-        .expect("times")
-        .iter()
-        .map(num)
-        .collect();
+    let times = nums(&fx["times"]);
     let filters = times
         .windows(2)
         .map(|w| cv(w[1] - w[0], q, r).expect("model"))

@@ -411,6 +411,21 @@ fn held_out_errors_by_hand(
         .collect()
 }
 
+/// The one-axis tracks of `series`, GSKF settings with window 2, T = 1 and the one option
+/// `g = 1` (no LAR stop), and [`held_out_errors_by_hand`] for them.
+fn correction_case(series: &[Vec<f64>]) -> (Vec<Trajectory>, GskfParams, Vec<(f64, f64)>) {
+    let tracks = one_axis_tracks(series);
+    let params = GskfParams {
+        window: 2,
+        horizons: 1,
+        q: None,
+        q_grid: vec![1.0],
+        choose_steps: false,
+    };
+    let by_hand = held_out_errors_by_hand(series, &tracks, &params, 1.0);
+    (tracks, params, by_hand)
+}
+
 /// The rule of the choice, applied by hand to per-group errors of equal counts: the
 /// correction when its pooled error is lower and its mean gain over the groups exceeds one
 /// standard error of that mean.
@@ -445,15 +460,7 @@ fn gskf_chooses_between_gsc_and_its_correction_by_held_out_groups() {
                     .collect()
             })
             .collect();
-        let tracks = one_axis_tracks(&series);
-        let params = GskfParams {
-            window: 2,
-            horizons: 1,
-            q: None,
-            q_grid: vec![1.0],
-            choose_steps: false,
-        };
-        let by_hand = held_out_errors_by_hand(&series, &tracks, &params, 1.0);
+        let (tracks, params, by_hand) = correction_case(&series);
         let correct = correction_wins(&by_hand);
         assert_eq!(correct, drift, "drift {drift}: {by_hand:?}");
         let mut gskf = Gskf::new(params.clone()).unwrap();
@@ -489,15 +496,7 @@ fn gskf_does_not_take_a_correction_that_one_wild_group_asks_for() {
     let series: Vec<Vec<f64>> = (0..4)
         .map(|g| ar2_series(100 + g, if g == 3 { 40.0 } else { 0.0 }, 300))
         .collect();
-    let tracks = one_axis_tracks(&series);
-    let params = GskfParams {
-        window: 2,
-        horizons: 1,
-        q: None,
-        q_grid: vec![1.0],
-        choose_steps: false,
-    };
-    let by_hand = held_out_errors_by_hand(&series, &tracks, &params, 1.0);
+    let (tracks, params, by_hand) = correction_case(&series);
     let pooled = |pick: fn(&(f64, f64)) -> f64| by_hand.iter().map(pick).sum::<f64>();
     assert!(
         pooled(|e| e.1) < pooled(|e| e.0),

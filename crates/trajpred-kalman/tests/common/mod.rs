@@ -57,3 +57,30 @@ pub fn x0_cv2() -> Gaussian<f64, U4> {
         covariance: Matrix4::from_diagonal(&Vector4::new(2.0, 2.0, 3.0, 3.0)),
     }
 }
+
+/// A committed fixture `fixtures/kalman/<name>` (JSON written by the script beside it).
+pub fn fixture(name: &str) -> serde_json::Value {
+    let path = format!(
+        "{}/../../fixtures/kalman/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    serde_json::from_str(&std::fs::read_to_string(path).expect("fixture")).expect("JSON")
+}
+
+/// A JSON number.
+pub fn num(v: &serde_json::Value) -> f64 {
+    v.as_f64().expect("number")
+}
+
+/// A JSON array of numbers.
+pub fn nums(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array().expect("array").iter().map(num).collect()
+}
+
+/// `ours` within `tol` of `theirs`, relative to `max(|theirs|, 1)`.
+pub fn close_rel(ours: f64, theirs: f64, tol: f64, what: &str) {
+    assert!(
+        (ours - theirs).abs() <= tol * theirs.abs().max(1.0),
+        "{what}: ours {ours}, filterpy {theirs}"
+    );
+}

@@ -144,61 +144,44 @@ pub fn run_smoother(
     let times = &flight.times;
     let z0 = prep.observed[prep.kept[0]];
     let merwe = MerweSigmaPoints::default;
+    // the forward filter of every step, built by `$make(dt, observation)`, then smoothed
+    macro_rules! smoothed {
+        ($d:ty, $make:expr) => {{
+            let obs = observation::<$d>(setup.position_sd)?;
+            let make = |dt: f64| $make(dt, obs.clone());
+            let start = initial::<$d>(z0, setup, noise);
+            smooth(&prep, times, &start, &make, frames)?
+        }};
+    }
     let predicted_enu = match (motion, forward) {
         (Motion::Cv, Forward::Kf) => {
-            let obs = observation::<U4>(setup.position_sd)?;
-            let make = |dt: f64| Kf::new(cv_model(noise, dt)?, obs.clone());
-            smooth(
-                &prep,
-                times,
-                &initial::<U4>(z0, setup, noise),
-                &make,
-                frames,
-            )?
+            smoothed!(U4, |dt, obs| Kf::new(cv_model(noise, dt)?, obs))
         }
         (Motion::Cv, Forward::Ukf) => {
-            let obs = observation::<U4>(setup.position_sd)?;
-            let make = |dt: f64| Ukf::new::<U4, U2>(cv_model(noise, dt)?, obs.clone(), merwe());
-            smooth(
-                &prep,
-                times,
-                &initial::<U4>(z0, setup, noise),
-                &make,
-                frames,
-            )?
+            smoothed!(U4, |dt, obs| Ukf::new::<U4, U2>(
+                cv_model(noise, dt)?,
+                obs,
+                merwe()
+            ))
         }
         (Motion::Cv, Forward::Ekf) => {
-            let obs = observation::<U4>(setup.position_sd)?;
-            let make = |dt: f64| Ekf::new::<f64, U4, U2>(cv_model(noise, dt)?, obs.clone());
-            smooth(
-                &prep,
-                times,
-                &initial::<U4>(z0, setup, noise),
-                &make,
-                frames,
-            )?
+            smoothed!(U4, |dt, obs| Ekf::new::<f64, U4, U2>(
+                cv_model(noise, dt)?,
+                obs
+            ))
         }
         (Motion::Ct, Forward::Ukf) => {
-            let obs = observation::<U5>(setup.position_sd)?;
-            let make = |dt: f64| Ukf::new::<U5, U2>(ct_model(noise, dt)?, obs.clone(), merwe());
-            smooth(
-                &prep,
-                times,
-                &initial::<U5>(z0, setup, noise),
-                &make,
-                frames,
-            )?
+            smoothed!(U5, |dt, obs| Ukf::new::<U5, U2>(
+                ct_model(noise, dt)?,
+                obs,
+                merwe()
+            ))
         }
         (Motion::Ct, Forward::Ekf) => {
-            let obs = observation::<U5>(setup.position_sd)?;
-            let make = |dt: f64| Ekf::new::<f64, U5, U2>(ct_model(noise, dt)?, obs.clone());
-            smooth(
-                &prep,
-                times,
-                &initial::<U5>(z0, setup, noise),
-                &make,
-                frames,
-            )?
+            smoothed!(U5, |dt, obs| Ekf::new::<f64, U5, U2>(
+                ct_model(noise, dt)?,
+                obs
+            ))
         }
         (Motion::Ct, Forward::Kf) => {
             return Err(experiment_err(
