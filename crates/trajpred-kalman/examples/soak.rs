@@ -493,9 +493,9 @@ pub fn soak_driver(soak: Soak, rng: &mut ChaCha8Rng) -> Part {
                                 checks.check(&d, at);
                             }
                         }
-                        let ll = f.log_likelihood();
-                        if !ll.is_finite() {
-                            checks.fail(format!("step {at}: total log-likelihood {ll}"));
+                        match f.log_likelihood() {
+                            Some(ll) if ll.is_finite() => {}
+                            ll => checks.fail(format!("step {at}: total log-likelihood {ll:?}")),
                         }
                     }
                     Ok(())

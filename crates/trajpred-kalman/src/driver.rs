@@ -168,6 +168,29 @@ where
     Ok(estimates)
 }
 
+/// What builds the filter of a time step for [`Timed`]: any function `Fn(dt) -> Result<F>`,
+/// or a type that can also rebuild a filter of another step in place
+/// ([`StepBuilder::rebuild`], by default a new [`StepBuilder::build`] over it).
+pub trait StepBuilder<T, F> {
+    /// The filter for a step of `dt` seconds.
+    fn build(&self, dt: T) -> Result<F>;
+
+    /// `filter`, built for another step, made the filter for a step of `dt` seconds (the
+    /// same value as [`StepBuilder::build`]`(dt)`); by default built anew. An in-place
+    /// rebuild (a linear KF whose transition is rewritten,
+    /// [`Kf::update_transition`](crate::Kf::update_transition)) moves no filter.
+    fn rebuild(&self, dt: T, filter: &mut F) -> Result<()> {
+        *filter = self.build(dt)?;
+        Ok(())
+    }
+}
+
+impl<T, F, Make: Fn(T) -> Result<F>> StepBuilder<T, F> for Make {
+    fn build(&self, dt: T) -> Result<F> {
+        self(dt)
+    }
+}
+
 /// A Gaussian [`Filter`] run by time steps: `make(dt)` builds the filter (its transition and
 /// noise) for a step of `dt` seconds; the last one built is kept and reused while the step
 /// stays the same, so a regularly sampled track builds it once.
@@ -179,7 +202,8 @@ where
     make: Make,
     state: Gaussian<T, D>,
     built: Option<(T, F)>,
-    log_likelihood: T,
+    /// `None`: not summed ([`Timed::without_log_likelihood`]).
+    log_likelihood: Option<T>,
 }
 
 impl<T, D, F, Make> Timed<T, D, F, Make>
@@ -194,13 +218,22 @@ where
             make,
             state,
             built: None,
-            log_likelihood: T::zero(),
+            log_likelihood: Some(T::zero()),
         }
     }
 
+    /// The same filter without summing the log-likelihood of its updates (one logarithm a
+    /// step saved, for runs that only want the estimate, such as a forecast);
+    /// [`Timed::log_likelihood`] is then `None`.
+    pub fn without_log_likelihood(mut self) -> Self {
+        self.log_likelihood = None;
+        self
+    }
+
     /// The total log-likelihood `sum_k ln N(y_k; 0, S_k)` of the observations this filter
-    /// has been updated with (what a maximum-likelihood fit of the noise maximises).
-    pub fn log_likelihood(&self) -> T {
+    /// has been updated with (what a maximum-likelihood fit of the noise maximises); `None`
+    /// after [`Timed::without_log_likelihood`].
+    pub fn log_likelihood(&self) -> Option<T> {
         self.log_likelihood
     }
 
@@ -213,7 +246,7 @@ where
 impl<T: RealField + Copy, D: Dim, M: Dim, F, Make> TimeStepFilter<T, D, M> for Timed<T, D, F, Make>
 where
     F: Filter<T, D, M>,
-    Make: Fn(T) -> Result<F>,
+    Make: StepBuilder<T, F>,
     DefaultAllocator: FilterAllocator<D, M>,
 {
     type Error = KalmanError;
@@ -223,10 +256,21 @@ where
         // built in its slot, used by reference: a filter is never moved once built
         let filter = match &mut self.built {
             Some((built_dt, f)) if *built_dt == dt => &*f,
-            slot => &slot.insert((dt, (self.make)(dt)?)).1,
+            Some((built_dt, f)) => {
+                // on an error the slot holds no filter (a rebuild may have been left halfway)
+                if let Err(e) = self.make.rebuild(dt, f) {
+                    self.built = None;
+                    return Err(e);
+                }
+                *built_dt = dt;
+                &*f
+            }
+            slot => &slot.insert((dt, self.make.build(dt)?)).1,
         };
         let step = filter.step(&self.state, z)?;
-        self.log_likelihood += step.log_likelihood();
+        if let Some(sum) = &mut self.log_likelihood {
+            *sum += step.log_likelihood();
+        }
         self.state = step.into_posterior();
         Ok(())
     }
@@ -235,15 +279,28 @@ where
         Ok(self.state.clone())
     }
 
+    /// The filter of the last step serves an offset equal to it; the others share one
+    /// scratch filter, built for the first and rebuilt for each next
+    /// ([`StepBuilder::rebuild`]).
     fn forecast_at(&self, offsets: &[T]) -> Result<Vec<Gaussian<T, D>>> {
+        let mut scratch: Option<F> = None;
         offsets
             .iter()
             .map(|&dt| {
                 check_dt(dt, "forecast offset")?;
-                match &self.built {
-                    Some((built_dt, f)) if *built_dt == dt => f.predict(&self.state),
-                    _ => (self.make)(dt)?.predict(&self.state),
+                if let Some((built_dt, f)) = &self.built
+                    && *built_dt == dt
+                {
+                    return f.predict(&self.state);
                 }
+                let f = match &mut scratch {
+                    Some(f) => {
+                        self.make.rebuild(dt, f)?;
+                        &*f
+                    }
+                    None => &*scratch.insert(self.make.build(dt)?),
+                };
+                f.predict(&self.state)
             })
             .collect()
     }

@@ -154,6 +154,31 @@ impl<Tr, Ob> Kf<Tr, Ob> {
         })
     }
 
+    /// Changes the transition in place through `change` (for example
+    /// [`kinematic_continuous_in_place`](crate::motion::kinematic_continuous_in_place) for the
+    /// next interval of an irregular track: no new filter is built), then checks it as
+    /// [`Kf::new`] does: its `Q` ([`Transition::check_process_noise`](crate::Transition::check_process_noise))
+    /// and its size against `H`. On an error the filter holds whatever `change` left, and
+    /// should not be used.
+    pub fn update_transition<T: RealField + Copy, D: Dim, M: Dim>(
+        &mut self,
+        change: impl FnOnce(&mut Tr) -> Result<()>,
+    ) -> Result<()>
+    where
+        Tr: LinearTransitionModel<T, D>,
+        Ob: LinearObservationModel<T, D, M>,
+        DefaultAllocator:
+            Allocator<D> + Allocator<D, D> + Allocator<M> + Allocator<M, M> + Allocator<M, D>,
+    {
+        change(&mut self.transition)?;
+        self.transition.check_process_noise()?;
+        check_dim(
+            "H columns",
+            self.transition.state_dim(),
+            self.observation.observation_matrix().ncols(),
+        )
+    }
+
     /// The prediction with the input checks `checks`, its finiteness not yet checked
     /// ([`linear_predict_unchecked_output`]).
     #[inline(always)]

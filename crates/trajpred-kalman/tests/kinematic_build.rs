@@ -104,3 +104,66 @@ fn a_bad_step_or_noise_is_still_a_typed_error() {
         "{e:?}"
     );
 }
+
+#[test]
+fn the_in_place_rebuild_equals_a_new_transition_at_every_step() {
+    use trajpred_kalman::motion::kinematic_continuous_in_place;
+    for layout in layouts() {
+        // run-time sizes, starting from another layout's transition (replaced, not rewritten)
+        let other = KinematicLayout::new(1, 2, StateOrder::AxisBlocks).expect("layout");
+        let mut tr = kinematic_continuous::<f64, Dyn>(other, 1.0, 1.0).expect("start");
+        for (k, dt) in STEPS.iter().enumerate() {
+            let q = 0.1 * (k + 1) as f64;
+            kinematic_continuous_in_place(&mut tr, layout, *dt, q).expect("in place");
+            let fresh = kinematic_continuous::<f64, Dyn>(layout, *dt, q).expect("fresh");
+            assert_eq!(tr, fresh, "{layout:?}, dt = {dt}");
+        }
+        // a bad step is an error and leaves the transition as it was
+        let before = tr.clone();
+        let e = kinematic_continuous_in_place(&mut tr, layout, -1.0, 1.0).expect_err("bad dt");
+        assert!(matches!(
+            e,
+            trajpred_kalman::KalmanError::Core(trajpred_core::Error::InvalidParameter { .. })
+        ));
+        assert_eq!(tr, before);
+    }
+    // a damped velocity (no kinematic pattern) is replaced by the kinematic transition
+    let layout = KinematicLayout::new(2, 2, StateOrder::PositionsFirst).expect("layout");
+    let mut tr = damped_velocity::<f64, U4>(layout, 2.0, 0.5, 30.0).expect("damped");
+    kinematic_continuous_in_place(&mut tr, layout, 2.0, 0.5).expect("in place");
+    assert_eq!(
+        tr,
+        kinematic_continuous::<f64, U4>(layout, 2.0, 0.5).expect("cv")
+    );
+}
+
+#[test]
+fn a_kf_whose_transition_changes_size_in_place_is_a_typed_error() {
+    use trajpred_kalman::motion::{kinematic_continuous_in_place, position_observation};
+    use trajpred_kalman::{Kf, LinearObservation};
+    let cv = KinematicLayout::new(2, 2, StateOrder::PositionsFirst).expect("layout");
+    let ca = KinematicLayout::new(2, 3, StateOrder::PositionsFirst).expect("layout");
+    let obs: LinearObservation<f64, Dyn, Dyn> = position_observation(cv, 4.0).expect("obs");
+    let mut kf = Kf::new(
+        kinematic_continuous::<f64, Dyn>(cv, 1.0, 1.0).expect("cv"),
+        obs,
+    )
+    .expect("kf");
+    kf.update_transition(|tr| kinematic_continuous_in_place(tr, cv, 3.0, 1.0))
+        .expect("same size");
+    assert_eq!(
+        kf.transition(),
+        &kinematic_continuous::<f64, Dyn>(cv, 3.0, 1.0).expect("cv")
+    );
+    // the constant-acceleration state has 6 components, H reads 4
+    let e = kf
+        .update_transition(|tr| kinematic_continuous_in_place(tr, ca, 3.0, 1.0))
+        .expect_err("size");
+    assert!(
+        matches!(
+            e,
+            trajpred_kalman::KalmanError::Core(trajpred_core::Error::DimensionMismatch { .. })
+        ),
+        "{e:?}"
+    );
+}

@@ -134,3 +134,62 @@ fn bad_settings_and_inputs_are_typed_errors() {
     // a requested time before the history's end is refused, not extrapolated backwards
     assert!(p.forecast_times(&one, &[0.5]).is_err());
 }
+
+/// The predictor rebuilds its filter in place for each interval (and for each forecast
+/// offset); the forecast must be, to the bit, the one of a filter built anew for every
+/// interval through the driver: the same mean and covariance at every requested time.
+#[test]
+fn in_place_rebuilds_forecast_what_fresh_filters_forecast() {
+    use nalgebra::{Matrix4, U2, U4, Vector2, Vector4};
+    use trajpred_core::Gaussian;
+    use trajpred_kalman::driver::{Timed, drive_each};
+    use trajpred_kalman::motion::{
+        KinematicLayout, StateOrder, kinematic_continuous, position_observation,
+    };
+    use trajpred_kalman::{Filter, KalmanError, Kf};
+    let tr = simulate(7, 60, 0.8, 4.0);
+    let (q, r, v0) = (0.8, 4.0, 100.0);
+    let p = KfTime::new(KfTimeParams {
+        fit_noise: false,
+        spectral_density: q,
+        r,
+        initial_rate_variance: v0,
+        ..Default::default()
+    })
+    .expect("params");
+    let end = tr.times()[tr.len() - 1];
+    let at = [end + 0.5, end + 2.0, end + 2.0 + 1e-9, end + 7.25];
+    let ours = p.forecast_times(&tr, &at).expect("forecast");
+    // by hand: a new filter for every interval, a new one for every offset
+    let layout = KinematicLayout::new(2, 2, StateOrder::PositionsFirst).expect("layout");
+    let make = |dt: f64| -> Result<_, KalmanError> {
+        Kf::new(
+            kinematic_continuous::<f64, U4>(layout, dt, q)?,
+            position_observation::<f64, U4, U2>(layout, r)?,
+        )
+    };
+    let first = tr.point(0);
+    let start = Gaussian::new(
+        Vector4::new(first[0], first[1], 0.0, 0.0),
+        Matrix4::from_diagonal(&Vector4::new(r, r, v0, v0)),
+    )
+    .expect("start");
+    let mut f = Timed::new(make, start);
+    let z: Vec<Option<Vector2<f64>>> = (0..tr.len())
+        .map(|k| Some(Vector2::new(tr.point(k)[0], tr.point(k)[1])))
+        .collect();
+    drive_each(&mut f, tr.times(), &z, |_, _| Ok(())).expect("runs");
+    // each offset predicted by a filter of its own, from the last estimate
+    let fresh: Vec<Gaussian<f64, U4>> = at
+        .iter()
+        .map(|t| make(t - end).and_then(|kf| kf.predict(f.state())))
+        .collect::<Result<_, _>>()
+        .expect("forecast");
+    for (j, g) in fresh.iter().enumerate() {
+        assert_eq!(ours.step(j + 1), &[g.mean[0], g.mean[1]][..], "mean {j}");
+        let c = ours.covariance(j + 1).expect("covariance");
+        for (a, b) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+            assert_eq!(c[(a, b)], g.covariance[(a, b)], "P {j} [{a},{b}]");
+        }
+    }
+}

@@ -10,9 +10,10 @@ use nalgebra::{Const, DefaultAllocator, Dim, Dyn, OMatrix, OVector, U1, U2, U3, 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use trajpred_core::{Error, Forecast, Gaussian, Predictor, Result, Trajectory};
-use trajpred_kalman::driver::{TimeStepFilter, Timed, drive_each};
+use trajpred_kalman::driver::{StepBuilder, TimeStepFilter, Timed, drive_each};
 use trajpred_kalman::motion::{
-    KinematicLayout, StateOrder, damped_velocity, kinematic_continuous, position_observation,
+    KinematicLayout, StateOrder, damped_velocity, kinematic_continuous,
+    kinematic_continuous_in_place, position_observation,
 };
 use trajpred_kalman::{FilterAllocator, KalmanError, Kf, LinearObservation, LinearTransition};
 
@@ -115,6 +116,47 @@ pub struct KfTime {
 
 type SizedKf<N, M> = Kf<LinearTransition<f64, N>, LinearObservation<f64, N, M>>;
 
+/// [`KfTime`]'s filter run by time steps.
+type TimedKf<N, M> = Timed<f64, N, SizedKf<N, M>, Steps<N, M>>;
+
+/// The filter of each time step of [`KfTime`]: its transition for the step (constant velocity
+/// or acceleration, or the damped velocity) and the one observation. A constant-velocity or
+/// -acceleration filter is rebuilt in place for a new step (its `F` and `Q` entries
+/// rewritten), so the run moves no filter.
+struct Steps<N: Dim, M: Dim>
+where
+    DefaultAllocator: FilterAllocator<N, M>,
+{
+    layout: KinematicLayout,
+    q: f64,
+    tau: Option<f64>,
+    obs: LinearObservation<f64, N, M>,
+}
+
+impl<N: Dim, M: Dim> StepBuilder<f64, SizedKf<N, M>> for Steps<N, M>
+where
+    DefaultAllocator: FilterAllocator<N, M>,
+{
+    fn build(&self, dt: f64) -> trajpred_kalman::Result<SizedKf<N, M>> {
+        let tr = match self.tau {
+            Some(tau) => damped_velocity::<f64, N>(self.layout, dt, self.q, tau)?,
+            None => kinematic_continuous::<f64, N>(self.layout, dt, self.q)?,
+        };
+        Kf::new(tr, self.obs.clone())
+    }
+
+    fn rebuild(&self, dt: f64, filter: &mut SizedKf<N, M>) -> trajpred_kalman::Result<()> {
+        match self.tau {
+            Some(_) => {
+                *filter = self.build(dt)?;
+                Ok(())
+            }
+            None => filter
+                .update_transition(|tr| kinematic_continuous_in_place(tr, self.layout, dt, self.q)),
+        }
+    }
+}
+
 /// Calls `$self.$method::<N, M>($args)` at the static state and observation sizes of a
 /// 1-3 axis constant-velocity or constant-acceleration state (dynamic sizes otherwise), so
 /// the filter's matrices live on the stack.
@@ -154,14 +196,15 @@ impl KfTime {
     }
 
     /// The filter after running through `history` with noise `(q, r)`, at state size `N`
-    /// and observation size `M` (static for 1-3 axes, see [`sized`]).
-    #[allow(clippy::type_complexity)]
+    /// and observation size `M` (static for 1-3 axes, see [`sized`]), summing the
+    /// log-likelihood of its updates when `likelihood`.
     fn run<N: Dim, M: Dim>(
         &self,
         history: &Trajectory,
         q: f64,
         r: f64,
-    ) -> Result<Timed<f64, N, SizedKf<N, M>, impl Fn(f64) -> trajpred_kalman::Result<SizedKf<N, M>>>>
+        likelihood: bool,
+    ) -> Result<TimedKf<N, M>>
     where
         DefaultAllocator: FilterAllocator<N, M>,
     {
@@ -171,12 +214,11 @@ impl KfTime {
         let tau = self.params.time_constant;
         // the observation is the same at every step: built (and checked) once
         let obs = position_observation::<f64, N, M>(layout, r).map_err(kalman)?;
-        let make = move |dt: f64| {
-            let tr = match tau {
-                Some(tau) => damped_velocity::<f64, N>(layout, dt, q, tau)?,
-                None => kinematic_continuous::<f64, N>(layout, dt, q)?,
-            };
-            Kf::new(tr, obs.clone())
+        let make = Steps {
+            layout,
+            q,
+            tau,
+            obs,
         };
         let first = history.point(0);
         let mut mean = OVector::<f64, N>::zeros_generic(nd, Const::<1>);
@@ -191,6 +233,9 @@ impl KfTime {
         }
         let start = Gaussian::new(mean, OMatrix::<f64, N, N>::from_diagonal(&var))?;
         let mut f = Timed::new(make, start);
+        if !likelihood {
+            f = f.without_log_likelihood();
+        }
         let z: Vec<Option<OVector<f64, M>>> = (0..history.len())
             .map(|k| {
                 let p = history.point(k);
@@ -210,8 +255,8 @@ impl KfTime {
     where
         DefaultAllocator: FilterAllocator<N, M>,
     {
-        match self.run::<N, M>(track, q, r) {
-            Ok(f) => f.log_likelihood(),
+        match self.run::<N, M>(track, q, r, true) {
+            Ok(f) => f.log_likelihood().unwrap_or(f64::NEG_INFINITY),
             Err(_) => f64::NEG_INFINITY,
         }
     }
@@ -226,7 +271,7 @@ impl KfTime {
         DefaultAllocator: FilterAllocator<N, M>,
     {
         let (q, r) = (self.params.spectral_density, self.params.r);
-        let f = self.run::<N, M>(history, q, r)?;
+        let f = self.run::<N, M>(history, q, r, false)?;
         let states = f.forecast_at(offsets).map_err(kalman)?;
         positions_forecast(&states, history.dim())
     }
