@@ -18,6 +18,9 @@ use nalgebra::{
 };
 use trajpred_core::Error as CoreError;
 
+mod in_place;
+pub use in_place::kinematic_continuous_in_place;
+
 /// How the kinematic state of several axes is laid out.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum StateOrder {
@@ -195,45 +198,6 @@ where
         ("spectral_density", spectral_density),
         continuous_noise_block,
     )
-}
-
-/// [`kinematic_continuous`] written into `transition` in place: when `transition` is already
-/// a kinematic transition of `layout` (of any step), its `F` and `Q` entries are rewritten for
-/// `dt` (no new value is built or moved: what a filter over an irregular track does at every
-/// step); otherwise it is replaced by [`kinematic_continuous`]`(layout, dt,
-/// spectral_density)`. Either way the result equals that value; the same errors, and
-/// `transition` is left as it was on an error.
-///
-/// ```
-/// use nalgebra::U4;
-/// use trajpred_kalman::motion::{
-///     KinematicLayout, StateOrder, kinematic_continuous, kinematic_continuous_in_place,
-/// };
-/// let l = KinematicLayout::new(2, 2, StateOrder::PositionsFirst)?;
-/// let mut tr = kinematic_continuous::<f64, U4>(l, 1.0, 0.5)?;
-/// kinematic_continuous_in_place(&mut tr, l, 2.5, 0.5)?;
-/// assert_eq!(tr, kinematic_continuous::<f64, U4>(l, 2.5, 0.5)?);
-/// # Ok::<(), trajpred_kalman::KalmanError>(())
-/// ```
-pub fn kinematic_continuous_in_place<T: RealField + Copy, D: Dim>(
-    transition: &mut LinearTransition<T, D>,
-    layout: KinematicLayout,
-    dt: f64,
-    spectral_density: f64,
-) -> Result<()>
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    check_positive("dt", dt, false)?;
-    check_positive("spectral_density", spectral_density, true)?;
-    let (f_block, q_block) = (
-        polynomial_block(dt),
-        continuous_noise_block(layout.derivatives, dt, spectral_density),
-    );
-    if !transition.set_kinematic_blocks(layout, f_block, q_block) {
-        *transition = kinematic_with(layout, f_block, q_block)?;
-    }
-    Ok(())
 }
 
 /// The kinematic transition of `layout` for `dt` with the noise block `noise(derivatives,
