@@ -6,7 +6,9 @@
 
 use nalgebra::DMatrix;
 use trajpred_core::Error as CoreError;
-use trajpred_sparse::{Error, ExclusionReason, Lars, Method, PathEvent, StopReason};
+use trajpred_sparse::{
+    Error, ExclusionReason, Gram, Lars, LarsParams, Method, PathEvent, StopReason,
+};
 
 fn small() -> (DMatrix<f64>, Vec<f64>) {
     let x = DMatrix::from_row_slice(
@@ -19,27 +21,45 @@ fn small() -> (DMatrix<f64>, Vec<f64>) {
     (x, vec![1.0, 2.0, 4.0, 3.0, 6.0])
 }
 
+/// The default settings, and the design used as given with and without the Gram matrix
+/// (whose diagonal then serves as the check of the design's entries).
+fn settings() -> [LarsParams; 3] {
+    let raw = Lars::params().fit_intercept(false).normalize(false);
+    [
+        Lars::params(),
+        raw.clone().gram(Gram::Precompute),
+        raw.gram(Gram::Never),
+    ]
+}
+
 #[test]
 fn nan_and_infinity_are_located() {
-    let (mut x, y) = small();
-    x[(3, 1)] = f64::NAN;
-    assert!(matches!(
-        Lars::params().fit(&x, &y),
-        Err(Error::NonFiniteEntry {
-            what: "design",
-            row: 3,
-            col: 1
-        })
-    ));
-    let (x, mut y) = small();
-    y[2] = f64::INFINITY;
-    assert!(matches!(
-        Lars::params().fit(&x, &y),
-        Err(Error::Core(CoreError::NonFinite {
-            what: "target",
-            index: 2
-        }))
-    ));
+    for params in settings() {
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let (mut x, y) = small();
+            x[(3, 1)] = bad;
+            assert!(
+                matches!(
+                    params.fit(&x, &y),
+                    Err(Error::NonFiniteEntry {
+                        what: "design",
+                        row: 3,
+                        col: 1
+                    })
+                ),
+                "{params:?} {bad}"
+            );
+        }
+        let (x, mut y) = small();
+        y[2] = f64::INFINITY;
+        assert!(matches!(
+            params.fit(&x, &y),
+            Err(Error::Core(CoreError::NonFinite {
+                what: "target",
+                index: 2
+            }))
+        ));
+    }
 }
 
 #[test]
@@ -203,12 +223,14 @@ fn max_steps_zero_and_alpha_min_above_the_start() {
 
 #[test]
 fn overflowing_column_is_reported() {
-    let (mut x, y) = small();
-    x[(2, 2)] = 1e200;
-    assert!(matches!(
-        Lars::params().fit(&x, &y),
-        Err(Error::Overflow { col: 2 })
-    ));
+    for params in settings() {
+        let (mut x, y) = small();
+        x[(2, 2)] = 1e200;
+        assert!(matches!(
+            params.fit(&x, &y),
+            Err(Error::Overflow { col: 2 })
+        ));
+    }
 }
 
 /// A target whose sum overflows used to give an infinite intercept and no error; now the

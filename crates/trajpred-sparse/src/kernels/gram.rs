@@ -125,7 +125,9 @@ fn gram_chunks<S: Simd, const NR: usize>(simd: S, job: GramPacked<'_>) {
             let m = GRAM_MV.min(nblocks - ib);
             for jb in ib..nblocks {
                 let (blocks, dims) = ((ib, jb), (pe, pl));
-                match m {
+                // the upper block triangle only: column block `jb` needs the row blocks up to
+                // `jb` (the first two column blocks of a group take one and two)
+                match m.min(jb - ib + 1) {
                     3 => gram_micro::<S, 3, NR>(simd, &t, len, blocks, g, dims),
                     2 => gram_micro::<S, 2, NR>(simd, &t, len, blocks, g, dims),
                     _ => gram_micro::<S, 1, NR>(simd, &t, len, blocks, g, dims),

@@ -180,7 +180,7 @@ impl WithSimd for OverColumns<'_> {
             out,
         } = self;
         match kernel {
-            ColumnKernel::Dots => dots_into(simd, (data, n), cols, (0, n), v, out),
+            ColumnKernel::Dots => dots_into(simd, (data, n), cols, (0, v.len()), v, out),
             ColumnKernel::Combine => combine_into(simd, (data, n), cols, (0, n), v, out),
             ColumnKernel::ResidualDots { y } => {
                 residual_dots_into(simd, (data, n), cols, v, y, out)
@@ -189,10 +189,11 @@ impl WithSimd for OverColumns<'_> {
     }
 }
 
-/// `out[k] = x_{cols[k]} . v` for the columns of the column-major `data` (`n` rows);
-/// `v.len() == n`, `out.len() == cols.len()`.
+/// `out[k] = x_{cols[k]}[..v.len()] . v` for the columns of the column-major `data` (column
+/// stride `n`): the whole columns when `v.len() == n`, their leading parts when shorter;
+/// `out.len() == cols.len()`.
 pub(crate) fn dots(data: &[f64], n: usize, cols: &[usize], v: &[f64], out: &mut [f64]) {
-    debug_assert_eq!(v.len(), n);
+    debug_assert!(v.len() <= n);
     debug_assert_eq!(out.len(), cols.len());
     arch().dispatch(OverColumns {
         kernel: ColumnKernel::Dots,
@@ -368,7 +369,7 @@ impl WithSimd for Forward<'_> {
                 for (r, x) in row[i0..i].iter().zip(&b[i0..i]) {
                     s += r * x;
                 }
-                b[i] = (b[i] - s) / row[i];
+                b[i] = (b[i] - s) * row[i].recip();
             }
             i0 = i1;
         }
@@ -417,7 +418,7 @@ impl WithSimd for Backward<'_> {
             let g0 = i1.saturating_sub(BACK_GROUP);
             for i in (g0..i1).rev() {
                 let row = &rows[i];
-                let xi = z[i] / row[i];
+                let xi = z[i] * row[i].recip();
                 z[i] = xi;
                 for (zj, rj) in z[g0..i].iter_mut().zip(&row[g0..i]) {
                     *zj -= rj * xi;

@@ -250,12 +250,24 @@ impl LarsParams {
             }
             .into());
         }
+        let use_gram = match self.gram {
+            Gram::Auto => p <= n && p <= 4096,
+            Gram::Precompute => true,
+            Gram::Never => false,
+        };
+        // used as given (neither centred nor scaled), the design's Gram matrix is computed
+        // first: its diagonal holds the squared norms, so its pass over X is the check's
+        let direct = use_gram && !self.fit_intercept && !self.normalize;
+        let early = direct.then(|| Core::new(x, y, true));
         // one pass per column: a NaN or infinity makes the squared norm non-finite, and only
         // then is the offending entry located
         let mut raw_norms = Vec::with_capacity(p);
         for j in 0..p {
             let col = x.column(j);
-            let sq = dot(col.as_slice(), col.as_slice());
+            let sq = match &early {
+                Some(core) => core.sq_norm(j),
+                None => dot(col.as_slice(), col.as_slice()),
+            };
             if !sq.is_finite() {
                 if let Some(row) = col.iter().position(|v| !v.is_finite()) {
                     return Err(Error::NonFiniteEntry {
@@ -343,16 +355,12 @@ impl LarsParams {
             .into());
         }
 
-        let use_gram = match self.gram {
-            Gram::Auto => p <= n && p <= 4096,
-            Gram::Precompute => true,
-            Gram::Never => false,
-        };
         let mut eligible = vec![true; p];
         for e in &excluded {
             eligible[e.feature] = false;
         }
-        let mut core = Core::new(xs, &ys, use_gram);
+        // (without centring, `ys` is `y`: the early Gram matrix's `X^T y` is the one needed)
+        let mut core = early.unwrap_or_else(|| Core::new(xs, &ys, use_gram));
         let mut path = core.run(self, &ys, eligible, &mut excluded);
         if matches!(
             path.stop,
