@@ -10,7 +10,7 @@
 //! `<problem>_update` for one half, where the problem is `kf` (2-D constant velocity),
 //! `kf_cheap` (the same with cheap input checks), `kf_general` (a damped constant velocity
 //! and positions measured at twice their scale: no structure for the KF to exploit),
-//! `kf_dense` (a random stable 6-state model with a dense 3-D observation), their adskalman
+//! `kf_dense` (a random stable 6-state model with a dense 3-D observation), `kf_dense_cheap`, their adskalman
 //! twins `ads`, `ads_general`, `ads_dense`, `ukf`, or `ukf_corr` (the UKF from a correlated
 //! input state); `none` measures the fixed overhead. The second argument is the number of
 //! steps. The inputs are the benchmark's (`benches/common/mod.rs`). Instructions per step:
@@ -138,9 +138,13 @@ fn main() {
             let case = general_case();
             filter_loop(steps, part, &case.kf, &case.state, &case.z)
         }
-        "kf_dense" => {
+        "kf_dense" | "kf_dense_cheap" => {
             let case = dense_case();
-            filter_loop(steps, part, &case.kf, &case.state, &case.z)
+            let kf = match problem {
+                "kf_dense_cheap" => case.kf.clone().with_input_checks(InputChecks::Cheap),
+                _ => case.kf.clone(),
+            };
+            filter_loop(steps, part, &kf, &case.state, &case.z)
         }
         "ads" => ads_loop(steps, part, &cv_case()),
         "ads_general" => ads_loop(steps, part, &general_case()),
