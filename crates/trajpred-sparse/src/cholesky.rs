@@ -75,7 +75,7 @@ impl CholeskyFactor {
         let k = row.len() - 1;
         debug_assert_eq!(z.len(), k);
         let s = kernels::forward_dot(row, z, k);
-        z.push((b_last - s) * row[k].recip());
+        z.push((b_last - s) / row[k]);
     }
 
     /// Solves `L z = b` in place.

@@ -369,7 +369,7 @@ impl WithSimd for Forward<'_> {
                 for (r, x) in row[i0..i].iter().zip(&b[i0..i]) {
                     s += r * x;
                 }
-                b[i] = (b[i] - s) * row[i].recip();
+                b[i] = (b[i] - s) / row[i];
             }
             i0 = i1;
         }
@@ -418,7 +418,7 @@ impl WithSimd for Backward<'_> {
             let g0 = i1.saturating_sub(BACK_GROUP);
             for i in (g0..i1).rev() {
                 let row = &rows[i];
-                let xi = z[i] * row[i].recip();
+                let xi = z[i] / row[i];
                 z[i] = xi;
                 for (zj, rj) in z[g0..i].iter_mut().zip(&row[g0..i]) {
                     *zj -= rj * xi;
