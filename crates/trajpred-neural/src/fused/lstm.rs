@@ -7,7 +7,7 @@
 //! `dW_hh = H_{prev}ᵀ dA`, `db = Σ dA`, `dX = dA W_ihᵀ`, one product each.
 
 use super::bridge;
-use super::{Mat, Real, add_column_sums, cell_backward, cell_forward, gemm, gemm_by_transpose};
+use super::{Mat, Real, add_column_sums, cell_backward, cell_forward, gemm};
 use crate::error::{CoreError, NeuralError, Result};
 use burn::backend::flex::FlexTensor;
 use burn::tensor::Tensor;
@@ -141,12 +141,7 @@ pub(crate) fn forward<T: Real>(
         let (c_done, c_rest) = cs.split_at_mut(t * bh);
         let a = &mut gates[t * bg..(t + 1) * bg];
         let c_prev = if t > 0 {
-            gemm_by_transpose(
-                Mat::new(&h_done[(t - 1) * bh..], batch, hidden),
-                Mat::new(w_hh, hidden, g4),
-                T::one(),
-                a,
-            )?;
+            T::step_mul_add(&h_done[(t - 1) * bh..], w_hh, (batch, hidden, g4), a)?;
             Some(&c_done[(t - 1) * bh..])
         } else {
             None
@@ -234,12 +229,7 @@ pub(crate) fn backward<T: Real>(
             da_t,
         );
         if t > 0 {
-            gemm(
-                Mat::new(da_t, batch, g4),
-                Mat::new(w_hh, hidden, g4).t(),
-                zero,
-                &mut dh_next,
-            )?;
+            T::step_mul_t(da_t, w_hh, (batch, g4, hidden), &mut dh_next)?;
         }
     }
     let mut dw_ih = vec![zero; input * g4];

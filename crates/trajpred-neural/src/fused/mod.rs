@@ -18,7 +18,8 @@
 //! [`adam`] is the optimizer that goes with them: burn's Adam, bit for bit, in one loop per
 //! parameter. The arithmetic is generic over `f32`/`f64` ([`Real`]): burn runs it in
 //! `f32`, the finite-difference tests in `f64`. Matrix products go through `ndarray`'s
-//! `general_mat_mul` on row-major views. The autodiff-composed models stay as the reference
+//! `general_mat_mul` on row-major views, except a recurrent step's two products in `f32`
+//! ([`Real::step_mul_add`], [`Real::step_mul_t`]: `small.rs`, without packing the weight). The autodiff-composed models stay as the reference
 //! (`TrainConfig::fused = false`); the tests in `fused/tests.rs` hold every gradient of
 //! the ops to it.
 
@@ -27,6 +28,7 @@ pub(crate) mod bridge;
 pub(crate) mod head;
 pub(crate) mod kfu;
 pub(crate) mod lstm;
+mod small;
 #[cfg(test)]
 mod tests;
 
@@ -43,11 +45,67 @@ pub(crate) trait Real:
     /// polynomial the compiler vectorises), the standard library's `exp` for `f64` (so the
     /// finite-difference checks see exact derivatives of what the backward passes assume).
     fn exp_gate(self) -> Self;
+
+    /// `out += h w` for row-major `h` (`rows x k`), `w` (`k x n`), `out` (`rows x n`): the
+    /// recurrent product of a step. [`gemm_by_transpose`] unless the type has a kernel.
+    fn step_mul_add(
+        h: &[Self],
+        w: &[Self],
+        (rows, k, n): (usize, usize, usize),
+        out: &mut [Self],
+    ) -> Result<()> {
+        gemm_by_transpose(Mat::new(h, rows, k), Mat::new(w, k, n), Self::one(), out)
+    }
+
+    /// `out = g w^T` for row-major `g` (`rows x n`), `w` (`k x n`), `out` (`rows x k`): a
+    /// step's gradient back through the recurrent weight. [`gemm`] unless the type has a
+    /// kernel.
+    fn step_mul_t(
+        g: &[Self],
+        w: &[Self],
+        (rows, n, k): (usize, usize, usize),
+        out: &mut [Self],
+    ) -> Result<()> {
+        gemm(
+            Mat::new(g, rows, n),
+            Mat::new(w, k, n).t(),
+            Self::zero(),
+            out,
+        )
+    }
 }
 impl Real for f32 {
     #[inline(always)]
     fn exp_gate(self) -> f32 {
         exp_f32(self)
+    }
+
+    /// [`small::mul_add`]: no packing of the weight (see there).
+    fn step_mul_add(
+        h: &[f32],
+        w: &[f32],
+        (rows, k, n): (usize, usize, usize),
+        out: &mut [f32],
+    ) -> Result<()> {
+        if h.len() != rows * k || w.len() != k * n || out.len() != rows * n {
+            return Err(shape_error("a step's matrix product"));
+        }
+        small::mul_add(h, w, (rows, k, n), out);
+        Ok(())
+    }
+
+    /// [`small::mul_t`]: no packing of the weight (see there).
+    fn step_mul_t(
+        g: &[f32],
+        w: &[f32],
+        (rows, n, k): (usize, usize, usize),
+        out: &mut [f32],
+    ) -> Result<()> {
+        if g.len() != rows * n || w.len() != k * n || out.len() != rows * k {
+            return Err(shape_error("a step's matrix product"));
+        }
+        small::mul_t(g, w, (rows, n, k), out);
+        Ok(())
     }
 }
 impl Real for f64 {
