@@ -47,6 +47,10 @@ pub(super) struct Core<'a> {
     /// the same way); a drop moves the positions after it. `pos_of` is the inverse of `perm`.
     perm: Vec<usize>,
     pos_of: Vec<usize>,
+    /// Without the Gram matrix: the inactive columns in the order of this step's pass over
+    /// `X`, and whether it runs from the last column.
+    order: Vec<usize>,
+    backwards: bool,
 }
 
 impl<'a> Core<'a> {
@@ -81,6 +85,8 @@ impl<'a> Core<'a> {
             a_inactive: Vec::with_capacity(p),
             perm: (0..p).collect(),
             pos_of: (0..p).collect(),
+            order: Vec::with_capacity(if use_gram { 0 } else { p }),
+            backwards: false,
         }
     }
 
@@ -143,9 +149,19 @@ impl<'a> Core<'a> {
                 let data = self.xs.as_slice();
                 kernels::combine(data, self.n, active, w, &mut self.u);
                 self.a_inactive.resize(self.inactive.len(), 0.0);
-                kernels::dots(data, self.n, &self.inactive, &self.u, &mut self.a_inactive);
+                // every other step the columns are taken from the last: the pass then starts
+                // on the columns the previous one ended with, which are still in cache when
+                // `X` is larger than it (each column's sum is the same in either order)
+                self.backwards = !self.backwards;
+                self.order.clear();
+                if self.backwards {
+                    self.order.extend(self.inactive.iter().rev());
+                } else {
+                    self.order.extend_from_slice(&self.inactive);
+                }
+                kernels::dots(data, self.n, &self.order, &self.u, &mut self.a_inactive);
                 a.fill(0.0);
-                for (&j, &v) in self.inactive.iter().zip(&self.a_inactive) {
+                for (&j, &v) in self.order.iter().zip(&self.a_inactive) {
                     a[j] = v;
                 }
             }
