@@ -217,19 +217,14 @@ pub(crate) fn forward<T: Real>(
             for row in a.chunks_exact_mut(g4) {
                 row.copy_from_slice(&params[at.b..at.b + g4]);
             }
-            gemm(
-                Mat::new(inp, batch, at.input),
-                Mat::new(&params[at.w_ih..at.b], at.input, g4),
-                T::one(),
-                a,
-            )?;
+            T::step_mul_add(inp, &params[at.w_ih..at.b], (batch, at.input, g4), a)?;
             let (h_done, h_rest) = cur.hs.split_at_mut(s * bh);
             let (c_done, c_rest) = cur.cs.split_at_mut(s * bh);
             let c_prev = if s > 0 {
-                gemm(
-                    Mat::new(&h_done[(s - 1) * bh..], batch, h),
-                    Mat::new(&params[at.w_hh..at.w_hh + h * g4], h, g4),
-                    T::one(),
+                T::step_mul_add(
+                    &h_done[(s - 1) * bh..],
+                    &params[at.w_hh..at.w_hh + h * g4],
+                    (batch, h, g4),
                     a,
                 )?;
                 Some(&c_done[(s - 1) * bh..])
@@ -259,12 +254,7 @@ pub(crate) fn forward<T: Real>(
             for row in o.chunks_exact_mut(at.output) {
                 row.copy_from_slice(&params[at.b..at.b + at.output]);
             }
-            gemm(
-                Mat::new(u, batch, at.input),
-                Mat::new(&params[at.w..at.b], at.input, at.output),
-                T::one(),
-                o,
-            )?;
+            T::step_mul_add(u, &params[at.w..at.b], (batch, at.input, at.output), o)?;
             if k < n_hidden_fc {
                 activate(spec.activation, o);
             }
@@ -426,10 +416,10 @@ pub(crate) fn backward<T: Real>(
         for k in (0..off.head.len()).rev() {
             let at = off.head[k];
             let gi = &mut g_in[..batch * at.input];
-            gemm(
-                Mat::new(&gpre[k][s * batch * at.output..], batch, at.output),
-                Mat::new(&params[at.w..at.b], at.input, at.output).t(),
-                zero,
+            T::step_mul_t(
+                &gpre[k][s * batch * at.output..],
+                &params[at.w..at.b],
+                (batch, at.output, at.input),
                 gi,
             )?;
             if k > 0 {
@@ -463,20 +453,15 @@ pub(crate) fn backward<T: Real>(
                 da_s,
             );
             if s > 0 {
-                gemm(
-                    Mat::new(da_s, batch, g4),
-                    Mat::new(&params[at.w_hh..at.w_hh + h * g4], h, g4).t(),
-                    zero,
+                T::step_mul_t(
+                    da_s,
+                    &params[at.w_hh..at.w_hh + h * g4],
+                    (batch, g4, h),
                     &mut dh_next[l],
                 )?;
             }
             let gi = &mut g_in[..batch * at.input];
-            gemm(
-                Mat::new(da_s, batch, g4),
-                Mat::new(&params[at.w_ih..at.b], at.input, g4).t(),
-                zero,
-                gi,
-            )?;
+            T::step_mul_t(da_s, &params[at.w_ih..at.b], (batch, g4, at.input), gi)?;
             if l > 0 {
                 g_h[..gi.len()].copy_from_slice(gi);
             } else {

@@ -87,10 +87,16 @@ impl Real for f32 {
         (rows, k, n): (usize, usize, usize),
         out: &mut [f32],
     ) -> Result<()> {
-        if h.len() != rows * k || w.len() != k * n || out.len() != rows * n {
+        // (operands may be longer than the product needs, as ndarray's views allow)
+        if h.len() < rows * k || w.len() < k * n || out.len() < rows * n {
             return Err(shape_error("a step's matrix product"));
         }
-        small::mul_add(h, w, (rows, k, n), out);
+        small::mul_add(
+            &h[..rows * k],
+            &w[..k * n],
+            (rows, k, n),
+            &mut out[..rows * n],
+        );
         Ok(())
     }
 
@@ -101,10 +107,15 @@ impl Real for f32 {
         (rows, n, k): (usize, usize, usize),
         out: &mut [f32],
     ) -> Result<()> {
-        if g.len() != rows * n || w.len() != k * n || out.len() != rows * k {
+        if g.len() < rows * n || w.len() < k * n || out.len() < rows * k {
             return Err(shape_error("a step's matrix product"));
         }
-        small::mul_t(g, w, (rows, n, k), out);
+        small::mul_t(
+            &g[..rows * n],
+            &w[..k * n],
+            (rows, n, k),
+            &mut out[..rows * k],
+        );
         Ok(())
     }
 }
