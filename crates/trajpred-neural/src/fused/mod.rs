@@ -87,16 +87,8 @@ impl Real for f32 {
         (rows, k, n): (usize, usize, usize),
         out: &mut [f32],
     ) -> Result<()> {
-        // (operands may be longer than the product needs, as ndarray's views allow)
-        if h.len() < rows * k || w.len() < k * n || out.len() < rows * n {
-            return Err(shape_error("a step's matrix product"));
-        }
-        small::mul_add(
-            &h[..rows * k],
-            &w[..k * n],
-            (rows, k, n),
-            &mut out[..rows * n],
-        );
+        let (h, w, out) = leading(h, w, out, (rows * k, k * n, rows * n))?;
+        small::mul_add(h, w, (rows, k, n), out);
         Ok(())
     }
 
@@ -107,16 +99,24 @@ impl Real for f32 {
         (rows, n, k): (usize, usize, usize),
         out: &mut [f32],
     ) -> Result<()> {
-        if g.len() < rows * n || w.len() < k * n || out.len() < rows * k {
-            return Err(shape_error("a step's matrix product"));
-        }
-        small::mul_t(
-            &g[..rows * n],
-            &w[..k * n],
-            (rows, n, k),
-            &mut out[..rows * k],
-        );
+        let (g, w, out) = leading(g, w, out, (rows * n, k * n, rows * k))?;
+        small::mul_t(g, w, (rows, n, k), out);
         Ok(())
+    }
+}
+
+/// The leading `lens` elements of two operands and an output, or a shape error when one is
+/// shorter (operands may be longer than a product needs, as ndarray's views allow).
+type Operands<'a> = (&'a [f32], &'a [f32], &'a mut [f32]);
+fn leading<'a>(
+    a: &'a [f32],
+    b: &'a [f32],
+    out: &'a mut [f32],
+    (la, lb, lo): (usize, usize, usize),
+) -> Result<Operands<'a>> {
+    match (a.get(..la), b.get(..lb), out.get_mut(..lo)) {
+        (Some(a), Some(b), Some(out)) => Ok((a, b, out)),
+        _ => Err(shape_error("a step's matrix product")),
     }
 }
 impl Real for f64 {
