@@ -32,7 +32,9 @@ impl CholeskyFactor {
     /// factor's order) and whose own squared norm is `gjj`.
     pub(crate) fn append(&mut self, g: &[f64], gjj: f64, tolerance: f64) -> Append {
         debug_assert_eq!(g.len(), self.len());
-        let mut w = g.to_vec();
+        // room for the diagonal entry too: the push below does not reallocate
+        let mut w = Vec::with_capacity(g.len() + 1);
+        w.extend_from_slice(g);
         self.forward_in_place(&mut w);
         let d2 = gjj - w.iter().map(|v| v * v).sum::<f64>();
         if !(d2.is_finite() && d2 > tolerance * gjj && gjj > 0.0) {
