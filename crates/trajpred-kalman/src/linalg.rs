@@ -8,7 +8,9 @@ use nalgebra::{Const, DefaultAllocator, Dim, Matrix, OMatrix, OVector, RealField
 use trajpred_core::Error as CoreError;
 use trajpred_core::Gaussian;
 
+mod congruence;
 mod factor;
+pub(crate) use congruence::{congruence_simd, congruence_simd_applies};
 pub(crate) use factor::{Chol, Ldl, cholesky, ldl};
 
 /// Errors with [`trajpred_core::Error::NonFinite`] if any element of `m` is NaN or infinite.

@@ -4,7 +4,7 @@
 
 use nalgebra::{
     Const, DMatrix, DVector, Matrix1, Matrix1x2, Matrix1x4, Matrix2, Matrix2x4, Matrix4, Matrix5,
-    U2, U3, U4, U6, Vector2, Vector4, Vector5,
+    SMatrix, SVector, U2, U3, U4, U6, Vector2, Vector4, Vector5,
 };
 use rand::RngExt;
 use rand::SeedableRng;
@@ -328,6 +328,66 @@ fn predict_accepts_and_rejects_p_at_every_scale() {
                         "{eig:?} x {scale:e}: {r:?}"
                     );
                 }
+            }
+        }
+    }
+}
+
+#[test]
+fn dense6_predict_accepts_and_rejects_p_at_every_scale() {
+    // the 6-state dense F (on machines with AVX2 or AVX-512, the SIMD `F P F^T` after the
+    // leading-minors check): the same verdicts as the exact check at every scale, and the
+    // prediction equal to rounding to the one of the cheap path (scalar `F P F^T`)
+    let mut rng = ChaCha8Rng::seed_from_u64(29);
+    let v = SMatrix::<f64, 6, 6>::from_fn(|_, _| rng.sample::<f64, _>(StandardNormal))
+        .qr()
+        .q();
+    let f = SMatrix::<f64, 6, 6>::from_fn(|_, _| 0.3 * rng.sample::<f64, _>(StandardNormal));
+    let q = SMatrix::<f64, 6, 6>::from_fn(|i, j| if i == j { 0.01 } else { 0.0 });
+    let h = SMatrix::<f64, 3, 6>::from_fn(|_, _| rng.sample::<f64, _>(StandardNormal));
+    let kf = Kf::new(
+        LinearTransition::new(f, q).unwrap(),
+        LinearObservation::new(h, SMatrix::<f64, 3, 3>::identity()).unwrap(),
+    )
+    .unwrap();
+    let cases: [([f64; 6], bool); 5] = [
+        ([1.0, 0.5, 0.2, 0.1, 2.0, 0.7], true),
+        ([1.0, 1e-12, 0.3, 0.2, 0.5, 0.4], true),
+        ([1.0, 0.0, 0.3, 0.2, 0.5, 0.4], true),
+        ([1.0, -1e-6, 0.3, 0.2, 0.5, 0.4], false),
+        ([1.0, 0.5, 0.3, 0.2, -0.5, 0.4], false),
+    ];
+    for scale in [1e-150, 1e-40, 1.0, 1e40, 1e150] {
+        for (eig, accept) in cases {
+            let p = v * SMatrix::<f64, 6, 6>::from_diagonal(&eig.into()) * v.transpose() * scale;
+            let p = (p + p.transpose()) * 0.5;
+            let state = Gaussian {
+                mean: SVector::<f64, 6>::from_fn(|i, _| i as f64),
+                covariance: p,
+            };
+            let r = kf.predict(&state);
+            if accept {
+                let pred = r.unwrap_or_else(|e| panic!("{eig:?} x {scale:e}: {e}"));
+                let cheap = kf
+                    .clone()
+                    .with_input_checks(InputChecks::Cheap)
+                    .predict(&state)
+                    .unwrap();
+                assert_eq!(pred.mean, cheap.mean);
+                assert_eq!(pred.covariance, pred.covariance.transpose());
+                let size = cheap.covariance.amax();
+                let diff = (pred.covariance - cheap.covariance).amax();
+                assert!(diff <= 1e-12 * size, "{eig:?} x {scale:e}: {diff:e}");
+            } else {
+                assert!(
+                    matches!(
+                        r,
+                        Err(KalmanError::Core(CoreError::NotPositiveDefinite {
+                            what: "P"
+                        }))
+                    ),
+                    "{eig:?} x {scale:e}: {r:?}"
+                );
             }
         }
     }

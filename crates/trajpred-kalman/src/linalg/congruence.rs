@@ -1,0 +1,265 @@
+//! `F P F^T + (Q + Q^T) / 2` for `f64` matrices of 5 to 8 states, written once against
+//! `pulp`'s safe SIMD types and dispatched at run time (AVX-512 or AVX2 with fused
+//! multiply-adds; without either, `None` and the caller keeps its scalar loops), as the
+//! kernels of trajpred-sparse and trajpred-neural are.
+//!
+//! The crate is built for the baseline x86-64 target (two-wide SSE2, no fused multiply-add),
+//! where the two dense products of a 6-state prediction (about 430 multiply-adds) took most
+//! of the step. Here a column of `P` or of the result is one or two vectors: `G = F P` as
+//! `G[:, j] = sum_k F[:, k] P[k, j]` (`P` read from its lower triangle), then the lower
+//! triangle of `G F^T + (Q + Q^T) / 2` as whole columns `sum_k G[:, k] F[j, k]`, mirrored so
+//! that the result is exactly symmetric. The sums run in the order of the scalar loops of
+//! [`mul`](super::mul) and [`mul_tr_sym_plus`](super::mul_tr_sym_plus), but with fused
+//! multiply-adds: the results agree to rounding (tests below).
+
+// the kernel indexes fixed-size arrays of vectors in lockstep
+#![allow(clippy::needless_range_loop)]
+
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim, OMatrix, RealField};
+use pulp::{Arch, Simd, WithSimd};
+use std::any::{Any, TypeId};
+
+/// The most vectors a column takes (8 states in vectors of at least 4 lanes).
+const MAX_VECTORS: usize = 2;
+
+/// `out = F P F^T + (Q + Q^T) / 2` (lower triangle formed, mirrored) for `N x N`
+/// column-major slices.
+struct Congruence<'a, const N: usize> {
+    f: &'a [f64],
+    p: &'a [f64],
+    q: &'a [f64],
+    out: &'a mut [f64],
+}
+
+impl<const N: usize> WithSimd for Congruence<'_, N> {
+    type Output = bool;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> bool {
+        let Congruence { f, p, q, out } = self;
+        let lanes = S::F64_LANES;
+        let len = N * N;
+        // scalar lanes: not worth it (the caller's loops are as good)
+        if !(4..=8).contains(&lanes)
+            || f.len() != len
+            || p.len() != len
+            || q.len() != len
+            || out.len() != len
+        {
+            return false;
+        }
+        let nv = N.div_ceil(lanes);
+        // `lanes` elements of `m` from `from` (whole vectors: the lanes past a column's end
+        // hold the next column's first rows, which no stored lane depends on; the last
+        // column's vector is read through a zero-padded copy)
+        let load = |m: &[f64], from: usize| {
+            if from + lanes <= len {
+                S::as_simd_f64s(&m[from..from + lanes]).0[0]
+            } else {
+                let mut t = [0.0; 8];
+                t[..len - from].copy_from_slice(&m[from..]);
+                S::as_simd_f64s(&t[..lanes]).0[0]
+            }
+        };
+        let zero = simd.splat_f64s(0.0);
+        let mut fc = [[zero; MAX_VECTORS]; N];
+        for k in 0..N {
+            for v in 0..nv {
+                fc[k][v] = load(f, k * N + v * lanes);
+            }
+        }
+        // G = F P, column by column (P[k, j] from the lower triangle)
+        let mut g = [[zero; MAX_VECTORS]; N];
+        for j in 0..N {
+            for k in 0..N {
+                let pkj = simd.splat_f64s(if k >= j { p[k + j * N] } else { p[j + k * N] });
+                for v in 0..nv {
+                    g[j][v] = simd.mul_add_e_f64s(fc[k][v], pkj, g[j][v]);
+                }
+            }
+        }
+        // (Q + Q^T) / 2 on and below the diagonal (the rest is overwritten by the mirror)
+        let mut qs = [0.0; 64];
+        for j in 0..N {
+            for i in j..N {
+                qs[i + j * N] = (q[i + j * N] + q[j + i * N]) * 0.5;
+            }
+        }
+        // out[:, j] = qs[:, j] + sum_k G[:, k] F[j, k], stored in increasing `j` (a store's
+        // lanes past the column's end are overwritten by the next column's)
+        for j in 0..N {
+            let mut acc = [zero; MAX_VECTORS];
+            for v in 0..nv {
+                acc[v] = load(&qs[..len], j * N + v * lanes);
+            }
+            for k in 0..N {
+                let fjk = simd.splat_f64s(f[j + k * N]);
+                for v in 0..nv {
+                    acc[v] = simd.mul_add_e_f64s(g[k][v], fjk, acc[v]);
+                }
+            }
+            for v in 0..nv {
+                let from = j * N + v * lanes;
+                if from + lanes <= len {
+                    S::as_mut_simd_f64s(&mut out[from..from + lanes]).0[0] = acc[v];
+                } else {
+                    let mut t = [0.0; 8];
+                    S::as_mut_simd_f64s(&mut t[..lanes]).0[0] = acc[v];
+                    out[from..].copy_from_slice(&t[..len - from]);
+                }
+            }
+        }
+        for j in 0..N {
+            for i in 0..j {
+                out[i + j * N] = out[j + i * N];
+            }
+        }
+        true
+    }
+}
+
+/// The column-major elements of `m` when `T` is `f64`.
+#[inline(always)]
+fn as_f64<T, D>(m: &OMatrix<T, D, D>) -> Option<&[f64]>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D>,
+{
+    (m as &dyn Any)
+        .downcast_ref::<OMatrix<f64, D, D>>()
+        .map(|m| m.as_slice())
+}
+
+/// Whether [`congruence_simd`] gives a result for these types on this machine: `f64`, a
+/// static size of 5 to 8, vectors of at least 4 lanes (AVX2 or AVX-512).
+#[inline(always)]
+pub(crate) fn congruence_simd_applies<T: RealField + Copy, D: Dim>() -> bool {
+    TypeId::of::<T>() == TypeId::of::<f64>()
+        && D::try_to_usize().is_some_and(|n| (5..=8).contains(&n))
+        && !matches!(Arch::new(), Arch::Scalar)
+}
+
+/// `F P F^T + (Q + Q^T) / 2`, exactly symmetric, from the lower triangle of `P`, through the
+/// SIMD kernel: `Some` for `f64` matrices of 5 to 8 states on a machine with AVX2 or
+/// AVX-512, `None` otherwise (the caller then forms it with its scalar loops).
+#[inline(always)]
+pub(crate) fn congruence_simd<T, D>(
+    f: &OMatrix<T, D, D>,
+    p: &OMatrix<T, D, D>,
+    q: &OMatrix<T, D, D>,
+) -> Option<OMatrix<T, D, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D>,
+{
+    if !congruence_simd_applies::<T, D>() {
+        return None;
+    }
+    let n = D::try_to_usize()?;
+    let (dd, _) = p.shape_generic();
+    let (f, p, q) = (as_f64(f)?, as_f64(p)?, as_f64(q)?);
+    let mut out = OMatrix::<T, D, D>::zeros_generic(dd, dd);
+    let o = (&mut out as &mut dyn Any).downcast_mut::<OMatrix<f64, D, D>>()?;
+    let out_slice = o.as_mut_slice();
+    let arch = Arch::new();
+    let done = match n {
+        5 => arch.dispatch(Congruence::<5> {
+            f,
+            p,
+            q,
+            out: out_slice,
+        }),
+        6 => arch.dispatch(Congruence::<6> {
+            f,
+            p,
+            q,
+            out: out_slice,
+        }),
+        7 => arch.dispatch(Congruence::<7> {
+            f,
+            p,
+            q,
+            out: out_slice,
+        }),
+        _ => arch.dispatch(Congruence::<8> {
+            f,
+            p,
+            q,
+            out: out_slice,
+        }),
+    };
+    done.then_some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::linalg::{mul, mul_tr_sym_plus};
+    use nalgebra::SMatrix;
+
+    /// Deterministic entries in [-1, 1).
+    fn entry(i: usize, seed: usize) -> f64 {
+        let x = (i as u64)
+            .wrapping_mul(2_654_435_761)
+            .wrapping_add(seed as u64 * 40_503);
+        (x % 2000) as f64 / 1000.0 - 1.0
+    }
+
+    fn check<const N: usize>() {
+        let f = SMatrix::<f64, N, N>::from_fn(|i, j| entry(i + N * j, 1));
+        let a = SMatrix::<f64, N, N>::from_fn(|i, j| entry(i + N * j, 2));
+        // symmetric positive definite P, a Q that is not exactly symmetric
+        let p = a * a.transpose() + SMatrix::<f64, N, N>::identity();
+        let q = SMatrix::<f64, N, N>::from_fn(|i, j| {
+            entry(i + N * j, 3) * 1e-2 + (i == j) as u8 as f64
+        });
+        let plain = mul_tr_sym_plus(&mul(&f, &p), &f, &q);
+        let arch_has_vectors = !matches!(Arch::new(), Arch::Scalar);
+        match congruence_simd(&f, &p, &q) {
+            Some(fast) => {
+                for j in 0..N {
+                    for i in 0..N {
+                        assert_eq!(fast[(i, j)], fast[(j, i)], "not mirrored at {i}, {j}");
+                        let scale = plain[(i, j)].abs().max(1.0);
+                        assert!(
+                            (fast[(i, j)] - plain[(i, j)]).abs() <= 1e-13 * scale,
+                            "N = {N}, ({i}, {j}): {} against {}",
+                            fast[(i, j)],
+                            plain[(i, j)]
+                        );
+                    }
+                }
+            }
+            None => assert!(
+                !arch_has_vectors,
+                "N = {N}: no kernel result on a SIMD machine"
+            ),
+        }
+        // the upper triangle of P is not read
+        let mut p_upper_nan = p;
+        for j in 0..N {
+            for i in 0..j {
+                p_upper_nan[(i, j)] = f64::NAN;
+            }
+        }
+        if let Some(fast) = congruence_simd(&f, &p_upper_nan, &q) {
+            assert!(fast.iter().all(|v| v.is_finite()));
+        }
+    }
+
+    #[test]
+    fn kernel_matches_the_plain_loops() {
+        check::<5>();
+        check::<6>();
+        check::<7>();
+        check::<8>();
+        // other sizes and types are left to the caller
+        let f4 = SMatrix::<f64, 4, 4>::identity();
+        assert!(congruence_simd(&f4, &f4, &f4).is_none());
+        let f6 = SMatrix::<f32, 6, 6>::identity();
+        assert!(congruence_simd(&f6, &f6, &f6).is_none());
+    }
+}
