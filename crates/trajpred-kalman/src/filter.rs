@@ -543,9 +543,7 @@ where
             (fast_ok && positive_definite_minors(state.covariance.clone()))
                 .then(|| tr.propagate_covariance(&state.covariance))
         } else if congruence_simd_applies::<T, D>() {
-            (fast_ok && positive_definite_minors(state.covariance.clone()))
-                .then(|| congruence_simd(f, &state.covariance, tr.process_noise()))
-                .flatten()
+            congruence_simd(f, &state.covariance, tr.process_noise()).filter(|_| fast_ok)
         } else {
             congruence_ldl(f, &state.covariance, tr.process_noise()).filter(|_| fast_ok)
         };

@@ -33,10 +33,12 @@ struct Congruence<'a, const N: usize> {
 }
 
 impl<const N: usize> WithSimd for Congruence<'_, N> {
-    type Output = bool;
+    /// `None` when not handled (vectors of fewer than 4 lanes), else whether `P` is
+    /// positive definite (and then `out` is written).
+    type Output = Option<bool>;
 
     #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) -> bool {
+    fn with_simd<S: Simd>(self, simd: S) -> Option<bool> {
         let Congruence { f, p, q, out } = self;
         let lanes = S::F64_LANES;
         let len = N * N;
@@ -47,7 +49,7 @@ impl<const N: usize> WithSimd for Congruence<'_, N> {
             || q.len() != len
             || out.len() != len
         {
-            return false;
+            return None;
         }
         let nv = N.div_ceil(lanes);
         // `lanes` elements of `m` from `from` (whole vectors: the lanes past a column's end
@@ -63,6 +65,40 @@ impl<const N: usize> WithSimd for Congruence<'_, N> {
             }
         };
         let zero = simd.splat_f64s(0.0);
+        // the leading principal minors of P by fraction-free elimination on whole columns:
+        // the operations of `positive_definite_minors` in the same order (no fused
+        // multiply-adds), so the same verdict; the lanes above the diagonal and past a
+        // column's end are never read by the lanes below it
+        let mut a = [[zero; MAX_VECTORS]; N];
+        for j in 0..N {
+            for v in 0..nv {
+                a[j][v] = load(p, j * N + v * lanes);
+            }
+        }
+        let big = f64::MAX;
+        let tiny = 1.0 / big;
+        let mut ok = true;
+        let mut inv_prev = 1.0;
+        let mut col = [0.0; 2 * 8];
+        for k in 0..N {
+            for v in 0..nv {
+                S::as_mut_simd_f64s(&mut col[v * lanes..(v + 1) * lanes]).0[0] = a[k][v];
+            }
+            let pk = col[k];
+            ok &= (pk >= tiny) & (pk <= big);
+            let (pv, iv) = (simd.splat_f64s(pk), simd.splat_f64s(inv_prev));
+            for j in (k + 1)..N {
+                let ajk = simd.splat_f64s(col[j]);
+                for v in 0..nv {
+                    let t = simd.sub_f64s(simd.mul_f64s(pv, a[j][v]), simd.mul_f64s(a[k][v], ajk));
+                    a[j][v] = simd.mul_f64s(t, iv);
+                }
+            }
+            inv_prev = 1.0 / pk;
+        }
+        if !ok {
+            return Some(false);
+        }
         let mut fc = [[zero; MAX_VECTORS]; N];
         for k in 0..N {
             for v in 0..nv {
@@ -79,19 +115,30 @@ impl<const N: usize> WithSimd for Congruence<'_, N> {
                 }
             }
         }
-        // (Q + Q^T) / 2 on and below the diagonal (the rest is overwritten by the mirror)
-        let mut qs = [0.0; 64];
+        // (Q + Q^T) / 2: an exactly symmetric Q (the usual case) is read as it is (with
+        // `(q + q) / 2 = q`, exact below `f64::MAX / 2`); otherwise a copy with the
+        // symmetrised lower triangle (the rest is overwritten by the mirror)
+        let mut q_exact = true;
         for j in 0..N {
-            for i in j..N {
-                qs[i + j * N] = (q[i + j * N] + q[j + i * N]) * 0.5;
+            for i in 0..j {
+                q_exact &= q[i + j * N] == q[j + i * N];
             }
         }
+        let mut qs = [0.0; 64];
+        if !q_exact {
+            for j in 0..N {
+                for i in j..N {
+                    qs[i + j * N] = (q[i + j * N] + q[j + i * N]) * 0.5;
+                }
+            }
+        }
+        let q_used = if q_exact { q } else { &qs[..len] };
         // out[:, j] = qs[:, j] + sum_k G[:, k] F[j, k], stored in increasing `j` (a store's
         // lanes past the column's end are overwritten by the next column's)
         for j in 0..N {
             let mut acc = [zero; MAX_VECTORS];
             for v in 0..nv {
-                acc[v] = load(&qs[..len], j * N + v * lanes);
+                acc[v] = load(q_used, j * N + v * lanes);
             }
             for k in 0..N {
                 let fjk = simd.splat_f64s(f[j + k * N]);
@@ -115,7 +162,7 @@ impl<const N: usize> WithSimd for Congruence<'_, N> {
                 out[i + j * N] = out[j + i * N];
             }
         }
-        true
+        Some(true)
     }
 }
 
@@ -142,8 +189,10 @@ pub(crate) fn congruence_simd_applies<T: RealField + Copy, D: Dim>() -> bool {
 }
 
 /// `F P F^T + (Q + Q^T) / 2`, exactly symmetric, from the lower triangle of `P`, through the
-/// SIMD kernel: `Some` for `f64` matrices of 5 to 8 states on a machine with AVX2 or
-/// AVX-512, `None` otherwise (the caller then forms it with its scalar loops).
+/// SIMD kernel, when `P` passes the leading-minors check (the verdict of
+/// [`positive_definite_minors`](super::positive_definite_minors), which it reproduces
+/// operation for operation): `Some` for such a `P` in `f64` matrices of 5 to 8 states on a
+/// machine with AVX2 or AVX-512 ([`congruence_simd_applies`]), `None` otherwise.
 #[inline(always)]
 pub(crate) fn congruence_simd<T, D>(
     f: &OMatrix<T, D, D>,
@@ -191,13 +240,13 @@ where
             out: out_slice,
         }),
     };
-    done.then_some(out)
+    (done == Some(true)).then_some(out)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::linalg::{mul, mul_tr_sym_plus};
+    use crate::linalg::{mul, mul_tr_sym_plus, positive_definite_minors};
     use nalgebra::SMatrix;
 
     /// Deterministic entries in [-1, 1).
@@ -216,27 +265,30 @@ mod tests {
         let q = SMatrix::<f64, N, N>::from_fn(|i, j| {
             entry(i + N * j, 3) * 1e-2 + (i == j) as u8 as f64
         });
-        let plain = mul_tr_sym_plus(&mul(&f, &p), &f, &q);
-        let arch_has_vectors = !matches!(Arch::new(), Arch::Scalar);
-        match congruence_simd(&f, &p, &q) {
-            Some(fast) => {
-                for j in 0..N {
-                    for i in 0..N {
-                        assert_eq!(fast[(i, j)], fast[(j, i)], "not mirrored at {i}, {j}");
-                        let scale = plain[(i, j)].abs().max(1.0);
-                        assert!(
-                            (fast[(i, j)] - plain[(i, j)]).abs() <= 1e-13 * scale,
-                            "N = {N}, ({i}, {j}): {} against {}",
-                            fast[(i, j)],
-                            plain[(i, j)]
-                        );
+        // a Q that is not exactly symmetric, and one that is
+        for q in [q, (q + q.transpose()) * 0.5] {
+            let plain = mul_tr_sym_plus(&mul(&f, &p), &f, &q);
+            let arch_has_vectors = !matches!(Arch::new(), Arch::Scalar);
+            match congruence_simd(&f, &p, &q) {
+                Some(fast) => {
+                    for j in 0..N {
+                        for i in 0..N {
+                            assert_eq!(fast[(i, j)], fast[(j, i)], "not mirrored at {i}, {j}");
+                            let scale = plain[(i, j)].abs().max(1.0);
+                            assert!(
+                                (fast[(i, j)] - plain[(i, j)]).abs() <= 1e-13 * scale,
+                                "N = {N}, ({i}, {j}): {} against {}",
+                                fast[(i, j)],
+                                plain[(i, j)]
+                            );
+                        }
                     }
                 }
+                None => assert!(
+                    !arch_has_vectors,
+                    "N = {N}: no kernel result on a SIMD machine"
+                ),
             }
-            None => assert!(
-                !arch_has_vectors,
-                "N = {N}: no kernel result on a SIMD machine"
-            ),
         }
         // the upper triangle of P is not read
         let mut p_upper_nan = p;
@@ -247,6 +299,14 @@ mod tests {
         }
         if let Some(fast) = congruence_simd(&f, &p_upper_nan, &q) {
             assert!(fast.iter().all(|v| v.is_finite()));
+        }
+        // the verdict of the scalar minors check: indefinite, semi-definite, huge
+        let mut indefinite = p;
+        indefinite[(N - 1, N - 1)] = -1.0;
+        let semidefinite = a.columns(0, 1) * a.columns(0, 1).transpose();
+        for bad in [indefinite, semidefinite, p * 1e300] {
+            assert!(!positive_definite_minors(bad));
+            assert!(congruence_simd(&f, &bad, &q).is_none());
         }
     }
 
