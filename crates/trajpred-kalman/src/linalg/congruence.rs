@@ -52,18 +52,6 @@ impl<const N: usize> WithSimd for Congruence<'_, N> {
             return None;
         }
         let nv = N.div_ceil(lanes);
-        // `lanes` elements of `m` from `from` (whole vectors: the lanes past a column's end
-        // hold the next column's first rows, which no stored lane depends on; the last
-        // column's vector is read through a zero-padded copy)
-        let load = |m: &[f64], from: usize| {
-            if from + lanes <= len {
-                S::as_simd_f64s(&m[from..from + lanes]).0[0]
-            } else {
-                let mut t = [0.0; 8];
-                t[..len - from].copy_from_slice(&m[from..]);
-                S::as_simd_f64s(&t[..lanes]).0[0]
-            }
-        };
         let zero = simd.splat_f64s(0.0);
         // the leading principal minors of P by fraction-free elimination on whole columns:
         // the operations of `positive_definite_minors` in the same order (no fused
@@ -72,7 +60,7 @@ impl<const N: usize> WithSimd for Congruence<'_, N> {
         let mut a = [[zero; MAX_VECTORS]; N];
         for j in 0..N {
             for v in 0..nv {
-                a[j][v] = load(p, j * N + v * lanes);
+                a[j][v] = load(simd, p, j * N + v * lanes);
             }
         }
         let big = f64::MAX;
@@ -102,7 +90,7 @@ impl<const N: usize> WithSimd for Congruence<'_, N> {
         let mut fc = [[zero; MAX_VECTORS]; N];
         for k in 0..N {
             for v in 0..nv {
-                fc[k][v] = load(f, k * N + v * lanes);
+                fc[k][v] = load(simd, f, k * N + v * lanes);
             }
         }
         // G = F P, column by column (P[k, j] from the lower triangle)
@@ -138,7 +126,7 @@ impl<const N: usize> WithSimd for Congruence<'_, N> {
         for j in 0..N {
             let mut acc = [zero; MAX_VECTORS];
             for v in 0..nv {
-                acc[v] = load(q_used, j * N + v * lanes);
+                acc[v] = load(simd, q_used, j * N + v * lanes);
             }
             for k in 0..N {
                 let fjk = simd.splat_f64s(f[j + k * N]);
@@ -147,14 +135,7 @@ impl<const N: usize> WithSimd for Congruence<'_, N> {
                 }
             }
             for v in 0..nv {
-                let from = j * N + v * lanes;
-                if from + lanes <= len {
-                    S::as_mut_simd_f64s(&mut out[from..from + lanes]).0[0] = acc[v];
-                } else {
-                    let mut t = [0.0; 8];
-                    S::as_mut_simd_f64s(&mut t[..lanes]).0[0] = acc[v];
-                    out[from..].copy_from_slice(&t[..len - from]);
-                }
+                store(simd, out, j * N + v * lanes, acc[v]);
             }
         }
         for j in 0..N {
@@ -164,6 +145,45 @@ impl<const N: usize> WithSimd for Congruence<'_, N> {
         }
         Some(true)
     }
+}
+
+/// `S::F64_LANES` (at most 8) elements of `m` from `from`, as a vector: the kernels read
+/// whole vectors (the lanes past a column's end hold the next column's first rows, which no
+/// stored lane depends on); a vector past the end of `m` is read through a zero-padded copy.
+#[inline(always)]
+pub(super) fn load<S: Simd>(_simd: S, m: &[f64], from: usize) -> S::f64s {
+    let lanes = S::F64_LANES;
+    if from + lanes <= m.len() {
+        S::as_simd_f64s(&m[from..from + lanes]).0[0]
+    } else {
+        let mut t = [0.0; 8];
+        t[..m.len() - from].copy_from_slice(&m[from..]);
+        S::as_simd_f64s(&t[..lanes]).0[0]
+    }
+}
+
+/// Stores the vector `x` at `from` in `m`, the lanes past the end of `m` dropped (the lanes
+/// past a column's end are overwritten when the next column is stored).
+#[inline(always)]
+pub(super) fn store<S: Simd>(_simd: S, m: &mut [f64], from: usize, x: S::f64s) {
+    let lanes = S::F64_LANES;
+    if from + lanes <= m.len() {
+        S::as_mut_simd_f64s(&mut m[from..from + lanes]).0[0] = x;
+    } else {
+        let mut t = [0.0; 8];
+        S::as_mut_simd_f64s(&mut t[..lanes]).0[0] = x;
+        let len = m.len();
+        m[from..].copy_from_slice(&t[..len - from]);
+    }
+}
+
+/// `f64` elements, a static size of 5 to 8, vectors of at least 4 lanes (AVX2 or AVX-512):
+/// where the kernels apply.
+#[inline(always)]
+pub(super) fn is_f64_of_size<T: RealField + Copy, D: Dim>() -> bool {
+    TypeId::of::<T>() == TypeId::of::<f64>()
+        && D::try_to_usize().is_some_and(|n| (5..=8).contains(&n))
+        && !matches!(Arch::new(), Arch::Scalar)
 }
 
 /// The column-major elements of `m` when `T` is `f64`.
@@ -183,9 +203,7 @@ where
 /// static size of 5 to 8, vectors of at least 4 lanes (AVX2 or AVX-512).
 #[inline(always)]
 pub(crate) fn congruence_simd_applies<T: RealField + Copy, D: Dim>() -> bool {
-    TypeId::of::<T>() == TypeId::of::<f64>()
-        && D::try_to_usize().is_some_and(|n| (5..=8).contains(&n))
-        && !matches!(Arch::new(), Arch::Scalar)
+    is_f64_of_size::<T, D>()
 }
 
 /// `F P F^T + (Q + Q^T) / 2`, exactly symmetric, from the lower triangle of `P`, through the
