@@ -143,16 +143,15 @@ where
     if is_static::<R, K>() && K::try_to_usize() != Some(0) {
         let (r, k) = a.shape_generic();
         let half = nalgebra::convert::<f64, T>(0.5);
-        let mut out = OMatrix::<T, R, R>::zeros_generic(r, r);
+        // (c + c^T) / 2 to start from, every entry (a zeroed matrix cost a call to `memset`)
+        let mut out =
+            OMatrix::<T, R, R>::from_fn_generic(r, r, |i, j| (c[(i, j)] + c[(j, i)]) * half);
         // the lower triangle, column by column with i innermost (contiguous), then mirrored;
         // above FULL_COLUMNS_ABOVE rows whole columns (constant trip counts: unrolled and
         // vectorised; the upper half is overwritten), each entry of the lower triangle the
         // same sum in the same order either way
         let from = |j: usize| if r.value() > FULL_COLUMNS_ABOVE { 0 } else { j };
         for j in 0..r.value() {
-            for i in from(j)..r.value() {
-                out[(i, j)] = (c[(i, j)] + c[(j, i)]) * half;
-            }
             for l in 0..k.value() {
                 let ajl = a[(j, l)];
                 for i in from(j)..r.value() {
@@ -198,14 +197,12 @@ where
         let half = nalgebra::convert::<f64, T>(0.5);
         let ks = mul(k, s);
         let u = OMatrix::<T, D, M>::from_fn_generic(d, m, |i, a| ks[(i, a)] * half - hp[(a, i)]);
-        let mut out = OMatrix::<T, D, D>::zeros_generic(d, d);
+        // a copy of `p` to start from (a zeroed matrix cost a call to `memset`)
+        let mut out = p.clone();
         // the lower triangle (whole columns above FULL_COLUMNS_ABOVE rows, as in
         // `mul_tr_sym_plus`: the upper half, read from `p`, is overwritten), then mirrored
         let from = |j: usize| if d.value() > FULL_COLUMNS_ABOVE { 0 } else { j };
         for j in 0..d.value() {
-            for i in from(j)..d.value() {
-                out[(i, j)] = p[(i, j)];
-            }
             for a in 0..m.value() {
                 let (kja, uja) = (k[(j, a)], u[(j, a)]);
                 for i in from(j)..d.value() {
