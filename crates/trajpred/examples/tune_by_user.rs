@@ -6,12 +6,16 @@
 //! ```sh
 //! cargo run --release -p trajpred --example tune_by_user -- geolife ../shared/data/geolife 5 55
 //! ```
-//! (dataset, path, `--max-gap`, `--min-points`; the split is `--split by-user`,
+//! (dataset, path, `--max-gap`, `--min-points`; a fifth argument `gbm` scores
+//! `aligned-gbm`'s variants instead, with a sixth `1` or `2` for the first or second
+//! round of them; the split is `--split by-user`,
 //! `--train-fraction 0.3`, `--seed 0`, the evaluation `--history 20 --horizon 5`.)
 
 use trajpred::dataset::{Dataset, Segmentation, load};
 use trajpred::harness::{EvalConfig, Split, group_ids, split_segments};
-use trajpred::predictors::{AlignedRidge, AlignedRidgeParams, cross_validate};
+use trajpred::predictors::{
+    AlignedGbm, AlignedGbmParams, AlignedRidge, AlignedRidgeParams, cross_validate,
+};
 use trajpred::registry::{MethodOptions, build};
 use trajpred_core::{Predictor, Result, Trajectory};
 
@@ -58,6 +62,96 @@ fn main() -> Result<()> {
         eval,
         ..Default::default()
     };
+    eprintln!("| variant | CV mean error (m), pooled | per fold |\n|---|---|---|");
+    let report = |name: &str, b: &dyn Fn() -> Result<Box<dyn Predictor>>| -> Result<()> {
+        let s = cross_validate(name, b, &tracks, &groups, 5, 0, &eval)?;
+        let f: Vec<String> = s.fold_errors.iter().map(|e| format!("{e:.3}")).collect();
+        eprintln!("| {name} | {:.3} | {} |", s.pooled_error, f.join(", "));
+        Ok(())
+    };
+    if arg(5, "ridge") == "gbm" {
+        if arg(6, "1") == "1" {
+            for name in ["cv-time", "aligned-ridge", "aligned-gbm"] {
+                report(name, &|| build(name, &opts))?;
+            }
+        }
+        let gbm = |name: &str, p: AlignedGbmParams| -> Result<()> {
+            report(name, &|| {
+                Ok(Box::new(AlignedGbm::new(p.clone())?) as Box<dyn Predictor>)
+            })
+        };
+        let base = AlignedGbmParams::default;
+        if arg(6, "1") == "1" {
+            gbm(
+                "gbm 100 rounds",
+                AlignedGbmParams {
+                    iterations: 100,
+                    ..base()
+                },
+            )?;
+            gbm(
+                "gbm 400 rounds lr 0.05",
+                AlignedGbmParams {
+                    iterations: 400,
+                    learning_rate: 0.05,
+                    ..base()
+                },
+            )?;
+            gbm(
+                "gbm no clipping",
+                AlignedGbmParams {
+                    clip_quantile: 1.0,
+                    ..base()
+                },
+            )?;
+            gbm(
+                "gbm clip 0.9",
+                AlignedGbmParams {
+                    clip_quantile: 0.9,
+                    ..base()
+                },
+            )?;
+            gbm("gbm 4 lags", AlignedGbmParams { lags: 4, ..base() })?;
+            gbm(
+                "gbm 15 leaves",
+                AlignedGbmParams {
+                    max_leaves: 15,
+                    ..base()
+                },
+            )?;
+            gbm(
+                "gbm leaf 400",
+                AlignedGbmParams {
+                    min_leaf_samples: 400.0,
+                    ..base()
+                },
+            )?;
+        } else {
+            gbm(
+                "gbm clip 0.8",
+                AlignedGbmParams {
+                    clip_quantile: 0.8,
+                    ..base()
+                },
+            )?;
+            gbm(
+                "gbm clip 0.7",
+                AlignedGbmParams {
+                    clip_quantile: 0.7,
+                    ..base()
+                },
+            )?;
+            gbm(
+                "gbm clip 0.8 100 rounds",
+                AlignedGbmParams {
+                    clip_quantile: 0.8,
+                    iterations: 100,
+                    ..base()
+                },
+            )?;
+        }
+        return Ok(());
+    }
     let mut variants: Vec<(String, AlignedRidgeParams)> = Vec::new();
     for &lambda in &[1e-2, 1e-1, 1.0, 10.0] {
         variants.push((
@@ -83,13 +177,6 @@ fn main() -> Result<()> {
             ridge(4, lambda, 5, &[2.0, 7.0]),
         ));
     }
-    eprintln!("| variant | CV mean error (m), pooled | per fold |\n|---|---|---|");
-    let report = |name: &str, b: &dyn Fn() -> Result<Box<dyn Predictor>>| -> Result<()> {
-        let s = cross_validate(name, b, &tracks, &groups, 5, 0, &eval)?;
-        let f: Vec<String> = s.fold_errors.iter().map(|e| format!("{e:.3}")).collect();
-        eprintln!("| {name} | {:.3} | {} |", s.pooled_error, f.join(", "));
-        Ok(())
-    };
     for name in ["cv-time", "gsc"] {
         report(name, &|| build(name, &opts))?;
     }

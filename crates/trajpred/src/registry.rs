@@ -129,6 +129,10 @@ pub const METHODS: &[MethodInfo] = &[
         description: "last velocity corrected by a ridge regression in the heading-aligned frame, strength chosen by CV by user",
     },
     MethodInfo {
+        name: "aligned-gbm",
+        description: "last velocity corrected by gradient-boosted trees in the heading-aligned frame",
+    },
+    MethodInfo {
         name: "auto",
         description: "the candidate with the lowest cross-validated error by user on the training part (see predictors::Auto)",
     },
@@ -275,6 +279,10 @@ pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
             horizons: opts.horizons,
             seed: opts.seed,
             eval: opts.eval,
+            ..Default::default()
+        })?),
+        "aligned-gbm" => Box::new(AlignedGbm::new(AlignedGbmParams {
+            horizons: opts.horizons,
             ..Default::default()
         })?),
         "auto" => Box::new(Auto::new(

@@ -1,5 +1,6 @@
 //! Every method of the four papers as a [`Predictor`](trajpred_core::Predictor).
 
+mod aligned_gbm;
 mod aligned_ridge;
 mod auto;
 mod blend;
@@ -13,6 +14,7 @@ mod kf_time;
 mod particle;
 mod poly;
 
+pub use aligned_gbm::{AlignedGbm, AlignedGbmParams};
 pub use aligned_ridge::{AlignedRidge, AlignedRidgeParams};
 pub use auto::{Auto, AutoParams, CandidateScore, DEFAULT_CANDIDATES, cross_validate};
 pub use blend::{Blend, BlendParams};

@@ -1,0 +1,199 @@
+//! `aligned-gbm`: what it learns, that its fit does not depend on the threads, and its typed
+//! errors.
+
+use trajpred::predictors::{AlignedGbm, AlignedGbmParams, CvTime};
+use trajpred_core::{Error, Predictor, Trajectory};
+
+/// Tracks that brake along a heading of their own: speed `10 - 0.2 t` m/s, heading `k`
+/// radians, irregular times.
+fn braking(k: usize) -> Trajectory {
+    let n = 45;
+    let t: Vec<f64> = (0..n)
+        .map(|i| i as f64 + 0.3 * ((i * 7 + k) % 4) as f64)
+        .collect();
+    let s: Vec<f64> = t.iter().map(|&t| 10.0 * t - 0.1 * t * t).collect();
+    let (c, sn) = ((k as f64).cos(), (k as f64).sin());
+    let x = s.iter().map(|s| 50.0 * k as f64 + c * s).collect();
+    let y = s.iter().map(|s| -20.0 * k as f64 + sn * s).collect();
+    Trajectory::from_axes(t, vec![x, y]).expect("finite, increasing")
+}
+
+fn params() -> AlignedGbmParams {
+    AlignedGbmParams {
+        horizons: 5,
+        min_leaf_samples: 5.0,
+        iterations: 100,
+        ..Default::default()
+    }
+}
+
+fn fitted(threads: usize) -> AlignedGbm {
+    let train: Vec<Trajectory> = (0..30).map(braking).collect();
+    let mut m = AlignedGbm::new(params()).expect("valid");
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("pool")
+        .install(|| m.fit(&train))
+        .expect("fits");
+    m
+}
+
+fn mean_error(p: &dyn Predictor, tracks: &[Trajectory]) -> f64 {
+    let (mut sum, mut n) = (0.0, 0);
+    for tr in tracks {
+        for o in [20, 25, 30] {
+            let h = tr.prefix(o + 1).expect("prefix");
+            let times = &tr.times()[o + 1..o + 6];
+            let f = p.forecast_times(&h, times).expect("forecast");
+            for (k, at) in (o + 1..o + 6).enumerate() {
+                let (a, b) = (f.step(k + 1), tr.point(at));
+                sum += (a[0] - b[0]).hypot(a[1] - b[1]);
+                n += 1;
+            }
+        }
+    }
+    sum / n as f64
+}
+
+#[test]
+fn learns_braking_that_the_last_velocity_misses_on_new_headings() {
+    let m = fitted(2);
+    // headings and offsets it was not trained on
+    let test: Vec<Trajectory> = (40..46).map(braking).collect();
+    let (gbm, cv) = (mean_error(&m, &test), mean_error(&CvTime::new(), &test));
+    assert!(cv > 1.0, "cv-time {cv}");
+    assert!(gbm < 0.3 * cv, "aligned-gbm {gbm} against cv-time {cv}");
+}
+
+#[test]
+fn one_and_two_threads_fit_the_same_trees() {
+    let (a, b) = (fitted(1), fitted(2));
+    assert_eq!(
+        a.fitted_params().expect("fitted"),
+        b.fitted_params().expect("fitted")
+    );
+}
+
+#[test]
+fn bad_parameters_and_misuse_are_typed_errors() {
+    let bad = |p: AlignedGbmParams, name: &str| {
+        assert!(
+            matches!(AlignedGbm::new(p), Err(Error::InvalidParameter { name: n, .. }) if n == name),
+            "{name}"
+        );
+    };
+    bad(
+        AlignedGbmParams {
+            lags: 0,
+            ..params()
+        },
+        "lags",
+    );
+    bad(
+        AlignedGbmParams {
+            window: 1,
+            ..params()
+        },
+        "window",
+    );
+    bad(
+        AlignedGbmParams {
+            horizons: 0,
+            ..params()
+        },
+        "horizons",
+    );
+    bad(
+        AlignedGbmParams {
+            learning_rate: f64::NAN,
+            ..params()
+        },
+        "learning_rate",
+    );
+    bad(
+        AlignedGbmParams {
+            max_leaves: 1,
+            ..params()
+        },
+        "max_leaves",
+    );
+    bad(
+        AlignedGbmParams {
+            min_leaf_samples: -1.0,
+            ..params()
+        },
+        "min_leaf_samples",
+    );
+    bad(
+        AlignedGbmParams {
+            clip_quantile: 0.4,
+            ..params()
+        },
+        "clip_quantile",
+    );
+    bad(
+        AlignedGbmParams {
+            max_samples: 0,
+            ..params()
+        },
+        "max_samples",
+    );
+
+    let tr = braking(1);
+    let h = tr.prefix(21).expect("prefix");
+    let unfitted = AlignedGbm::new(params()).expect("valid");
+    assert!(matches!(
+        unfitted.forecast(&h, 3),
+        Err(Error::NotFitted { .. })
+    ));
+    assert!(matches!(
+        unfitted.fitted_params(),
+        Err(Error::NotFitted { .. })
+    ));
+
+    let m = fitted(2);
+    assert!(matches!(
+        m.forecast(&h, 6),
+        Err(Error::InvalidParameter {
+            name: "horizon",
+            ..
+        })
+    ));
+    assert!(matches!(
+        m.forecast_times(&h, &[h.times()[20]]),
+        Err(Error::InvalidParameter { name: "times", .. })
+    ));
+    assert!(matches!(
+        m.forecast(&tr.prefix(5).expect("prefix"), 2),
+        Err(Error::TooShort { .. })
+    ));
+    // too little to train on: one short track has no origin with 8 legs behind it
+    let mut short = AlignedGbm::new(params()).expect("valid");
+    let tiny = tr.prefix(9).expect("prefix");
+    assert!(matches!(short.fit(&[tiny]), Err(Error::TooShort { .. })));
+
+    // saved parameters of another shape are refused, naming the field
+    let saved = m.fitted_params().expect("fitted");
+    let mut other = AlignedGbm::new(AlignedGbmParams {
+        lags: 4,
+        ..params()
+    })
+    .expect("valid");
+    assert!(matches!(
+        other.load_fitted_params(&saved),
+        Err(Error::InvalidFitted { path, .. }) if path == "lags"
+    ));
+    let mut broken = saved.clone();
+    broken["models"] = serde_json::json!([1, 2]);
+    let mut same = AlignedGbm::new(params()).expect("valid");
+    assert!(matches!(
+        same.load_fitted_params(&broken),
+        Err(Error::InvalidFitted { path, .. }) if path == "models"
+    ));
+    same.load_fitted_params(&saved).expect("loads");
+    assert_eq!(
+        same.forecast(&h, 5).expect("forecast"),
+        m.forecast(&h, 5).expect("forecast")
+    );
+}
