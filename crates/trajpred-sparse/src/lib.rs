@@ -27,6 +27,7 @@ pub mod error;
 pub mod gsc;
 mod kernels;
 pub mod lars;
+mod workspace;
 
 pub use error::{Error, Result};
 pub use gsc::{GroupSparseCoder, GscParams};

@@ -87,7 +87,7 @@ fn gram_chunks<S: Simd, const NR: usize>(simd: S, job: GramPacked<'_>) {
     let l = S::F64_LANES;
     let nblocks = pl / l;
     let block = GRAM_ROWS * l;
-    let mut t = vec![0.0; nblocks * block];
+    let mut t = crate::workspace::zeroed(nblocks * block);
     let mut r0 = 0;
     while r0 < n {
         let len = GRAM_ROWS.min(n - r0);
@@ -137,6 +137,7 @@ fn gram_chunks<S: Simd, const NR: usize>(simd: S, job: GramPacked<'_>) {
         }
         r0 += len;
     }
+    crate::workspace::recycle(t);
 }
 
 impl WithSimd for GramPacked<'_> {
@@ -162,7 +163,7 @@ pub(crate) fn gram(data: &[f64], n: usize, p: usize, extra: &[f64]) -> (Vec<f64>
     debug_assert_eq!(extra.len(), n);
     let l = lanes();
     let pl = (p + 1).div_ceil(l) * l;
-    let mut gp = vec![0.0; pl * pl];
+    let mut gp = crate::workspace::zeroed(pl * pl);
     if n > 0 && p > 0 {
         arch().dispatch(GramPacked {
             data,

@@ -53,6 +53,16 @@ pub(super) struct Core<'a> {
     backwards: bool,
 }
 
+impl Drop for Core<'_> {
+    /// The Gram matrix's buffer is kept for the next fit on this thread (see
+    /// [`crate::workspace`]).
+    fn drop(&mut self) {
+        if let Some(g) = self.gram.take() {
+            crate::workspace::recycle(g);
+        }
+    }
+}
+
 impl<'a> Core<'a> {
     /// With `use_gram`, `X^T X` and `X^T ys` are computed here, in one pass over `X`.
     pub(super) fn new(xs: &'a DMatrix<f64>, ys: &[f64], use_gram: bool) -> Self {
