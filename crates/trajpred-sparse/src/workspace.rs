@@ -70,6 +70,43 @@ pub(crate) fn recycle(buf: Vec<f64>) {
     });
 }
 
+/// `f64`s in a 64-byte line: a vector of AVX-512.
+const LINE: usize = 8;
+
+/// A zeroed buffer from the pool whose first value starts a 64-byte cache line (a vector
+/// load from it, at a multiple of 8 values, never straddles two lines: an unaligned 512-bit
+/// load that does costs two of the core's load slots), given back to the pool when dropped.
+pub(crate) struct Aligned {
+    buf: Vec<f64>,
+    off: usize,
+    len: usize,
+}
+
+impl Aligned {
+    /// `len` zeros, line-aligned.
+    pub(crate) fn zeroed(len: usize) -> Self {
+        let buf = zeroed(len + LINE - 1);
+        // (the address is only looked at, never made into a pointer again)
+        let misalign = (buf.as_ptr() as usize / size_of::<f64>()) % LINE;
+        let off = (LINE - misalign) % LINE;
+        Aligned { buf, off, len }
+    }
+
+    pub(crate) fn as_slice(&self) -> &[f64] {
+        &self.buf[self.off..self.off + self.len]
+    }
+
+    pub(crate) fn as_mut_slice(&mut self) -> &mut [f64] {
+        &mut self.buf[self.off..self.off + self.len]
+    }
+}
+
+impl Drop for Aligned {
+    fn drop(&mut self) {
+        recycle(std::mem::take(&mut self.buf));
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -90,6 +127,12 @@ mod tests {
         }
         // too large to keep
         recycle(Vec::with_capacity(KEEP_BYTES / 8 + 1));
+        let mut a = Aligned::zeroed(333);
+        assert_eq!(a.as_slice().len(), 333);
+        assert_eq!(a.as_slice().as_ptr() as usize % 64, 0);
+        assert!(a.as_slice().iter().all(|&v| v == 0.0));
+        a.as_mut_slice()[332] = 1.0;
+        drop(a);
         POOL.with_borrow(|pool| {
             assert!(pool.len() <= KEEP);
             assert!(pool.iter().map(|b| b.capacity() * 8).sum::<usize>() <= KEEP_BYTES);

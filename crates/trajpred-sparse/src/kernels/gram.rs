@@ -1,6 +1,7 @@
 //! `X^T X` (and `X^T y` in the same pass) by a register-blocked kernel over packed rows.
 
 use super::arch;
+use crate::workspace::Aligned;
 use pulp::{Simd, WithSimd};
 
 /// The Gram matrix is accumulated over chunks of `GRAM_ROWS` rows: each chunk of `X` is first
@@ -87,7 +88,8 @@ fn gram_chunks<S: Simd, const NR: usize>(simd: S, job: GramPacked<'_>) {
     let l = S::F64_LANES;
     let nblocks = pl / l;
     let block = GRAM_ROWS * l;
-    let mut t = crate::workspace::zeroed(nblocks * block);
+    let mut t = crate::workspace::Aligned::zeroed(nblocks * block);
+    let t = t.as_mut_slice();
     let mut r0 = 0;
     while r0 < n {
         let len = GRAM_ROWS.min(n - r0);
@@ -128,16 +130,15 @@ fn gram_chunks<S: Simd, const NR: usize>(simd: S, job: GramPacked<'_>) {
                 // the upper block triangle only: column block `jb` needs the row blocks up to
                 // `jb` (the first two column blocks of a group take one and two)
                 match m.min(jb - ib + 1) {
-                    3 => gram_micro::<S, 3, NR>(simd, &t, len, blocks, g, dims),
-                    2 => gram_micro::<S, 2, NR>(simd, &t, len, blocks, g, dims),
-                    _ => gram_micro::<S, 1, NR>(simd, &t, len, blocks, g, dims),
+                    3 => gram_micro::<S, 3, NR>(simd, t, len, blocks, g, dims),
+                    2 => gram_micro::<S, 2, NR>(simd, t, len, blocks, g, dims),
+                    _ => gram_micro::<S, 1, NR>(simd, t, len, blocks, g, dims),
                 }
             }
             ib += m;
         }
         r0 += len;
     }
-    crate::workspace::recycle(t);
 }
 
 impl WithSimd for GramPacked<'_> {
@@ -159,11 +160,12 @@ impl WithSimd for GramPacked<'_> {
 /// `[X extra]^T [X extra]` by a register-blocked kernel over packed chunks of rows (see
 /// [`GRAM_ROWS`]), then mirrored in place. Every entry is one chain of fused multiply-adds over
 /// the rows in order, whichever block computed it. Returns `(G, ld, X^T extra)`.
-pub(crate) fn gram(data: &[f64], n: usize, p: usize, extra: &[f64]) -> (Vec<f64>, usize, Vec<f64>) {
+pub(crate) fn gram(data: &[f64], n: usize, p: usize, extra: &[f64]) -> (Aligned, usize, Vec<f64>) {
     debug_assert_eq!(extra.len(), n);
     let l = lanes();
     let pl = (p + 1).div_ceil(l) * l;
-    let mut gp = crate::workspace::zeroed(pl * pl);
+    let mut buf = Aligned::zeroed(pl * pl);
+    let gp = buf.as_mut_slice();
     if n > 0 && p > 0 {
         arch().dispatch(GramPacked {
             data,
@@ -171,7 +173,7 @@ pub(crate) fn gram(data: &[f64], n: usize, p: usize, extra: &[f64]) -> (Vec<f64>
             p,
             extra,
             pl,
-            g: &mut gp,
+            g: gp,
         });
     }
     let xty = gp[p * pl..p * pl + p].to_vec();
@@ -186,7 +188,7 @@ pub(crate) fn gram(data: &[f64], n: usize, p: usize, extra: &[f64]) -> (Vec<f64>
             }
         }
     }
-    (gp, pl, xty)
+    (buf, pl, xty)
 }
 
 struct Lanes;

@@ -65,6 +65,7 @@ fn kernels_agree_with_plain_loops_on_awkward_sizes() {
             );
         }
         let (g, ld, xtv) = gram(&x, n, p, &v);
+        let g = g.as_slice();
         for j in 0..p {
             let want = naive_dot(&x[j * n..(j + 1) * n], &v);
             assert!(close(xtv[j], want), "gram X^T v {n}x{p} col {j}");

@@ -5,6 +5,7 @@ use super::knots::Knots;
 use super::{Exclusion, ExclusionReason, LarsParams, Method, PathEvent, StopReason};
 use crate::cholesky::{Append, CholeskyFactor};
 use crate::kernels::{self, dot};
+use crate::workspace::Aligned;
 use nalgebra::DMatrix;
 
 /// A refinement correction at most this many `eps` of the largest active coefficient is
@@ -27,7 +28,7 @@ pub(super) struct Core<'a> {
     n: usize,
     p: usize,
     /// `X^T X` (column-major p x p, column stride `ld`), when precomputed.
-    gram: Option<Vec<f64>>,
+    gram: Option<Aligned>,
     ld: usize,
     /// `X^T y`, computed with the Gram matrix.
     xty: Option<Vec<f64>>,
@@ -53,16 +54,6 @@ pub(super) struct Core<'a> {
     backwards: bool,
 }
 
-impl Drop for Core<'_> {
-    /// The Gram matrix's buffer is kept for the next fit on this thread (see
-    /// [`crate::workspace`]).
-    fn drop(&mut self) {
-        if let Some(g) = self.gram.take() {
-            crate::workspace::recycle(g);
-        }
-    }
-}
-
 impl<'a> Core<'a> {
     /// With `use_gram`, `X^T X` and `X^T ys` are computed here, in one pass over `X`.
     pub(super) fn new(xs: &'a DMatrix<f64>, ys: &[f64], use_gram: bool) -> Self {
@@ -74,7 +65,7 @@ impl<'a> Core<'a> {
             (None, p, None)
         };
         let sq_norms = match &gram {
-            Some(g) => (0..p).map(|j| g[j * ld + j]).collect(),
+            Some(g) => (0..p).map(|j| g.as_slice()[j * ld + j]).collect(),
             None => (0..p)
                 .map(|j| {
                     let c = &xs.as_slice()[j * n..(j + 1) * n];
@@ -113,7 +104,10 @@ impl<'a> Core<'a> {
     fn gram_with_active(&self, active: &[usize], j: usize, out: &mut Vec<f64>) {
         out.clear();
         match &self.gram {
-            Some(g) => out.extend(active.iter().map(|&a| g[j * self.ld + self.pos_of[a]])),
+            Some(g) => {
+                let g = g.as_slice();
+                out.extend(active.iter().map(|&a| g[j * self.ld + self.pos_of[a]]));
+            }
             None => {
                 out.resize(active.len(), 0.0);
                 kernels::dots(self.xs.as_slice(), self.n, active, self.col(j), out);
@@ -135,6 +129,7 @@ impl<'a> Core<'a> {
     ) {
         match self.gram.as_mut() {
             Some(g) => {
+                let g = g.as_mut_slice();
                 let ld = self.ld;
                 for (pos, &f) in active.iter().enumerate() {
                     if self.perm[pos] != f {
