@@ -181,7 +181,7 @@ impl WithSimd for OverColumns<'_> {
         } = self;
         match kernel {
             ColumnKernel::Dots => dots_into(simd, (data, n), cols, (0, v.len()), v, out),
-            ColumnKernel::Combine => combine_into(simd, (data, n), cols, (0, n), v, out),
+            ColumnKernel::Combine => combine_into(simd, (data, n), cols, (0, out.len()), v, out),
             ColumnKernel::ResidualDots { y } => {
                 residual_dots_into(simd, (data, n), cols, v, y, out)
             }
@@ -268,11 +268,12 @@ fn residual_dots_into<S: Simd>(
     out: &mut [f64],
 ) {
     out.fill(0.0);
-    let mut r = vec![0.0; RESIDUAL_ROWS.min(n)];
+    let rows = y.len();
+    let mut r = vec![0.0; RESIDUAL_ROWS.min(rows)];
     let mut part = vec![0.0; cols.len()];
     let mut r0 = 0;
-    while r0 < n {
-        let r1 = (r0 + RESIDUAL_ROWS).min(n);
+    while r0 < rows {
+        let r1 = (r0 + RESIDUAL_ROWS).min(rows);
         let rb = &mut r[..r1 - r0];
         combine_into(simd, (data, n), cols, (r0, r1), b, rb);
         for (ri, yi) in rb.iter_mut().zip(&y[r0..r1]) {
@@ -286,8 +287,8 @@ fn residual_dots_into<S: Simd>(
     }
 }
 
-/// `out = X_S^T (y - X_S b)` for the columns `S = cols` of the column-major `data` (`n`
-/// rows), by blocks of rows, so that `X_S` is read from memory once.
+/// `out = X_S^T (y - X_S b)` for the columns `S = cols` of the column-major `data` (column
+/// stride `n`, `y.len() <= n` rows), by blocks of rows, so that `X_S` is read from memory once.
 pub(crate) fn residual_dots(
     data: &[f64],
     n: usize,
@@ -296,7 +297,7 @@ pub(crate) fn residual_dots(
     y: &[f64],
     out: &mut [f64],
 ) {
-    debug_assert_eq!(y.len(), n);
+    debug_assert!(y.len() <= n);
     debug_assert_eq!(b.len(), cols.len());
     debug_assert_eq!(out.len(), cols.len());
     arch().dispatch(OverColumns {
@@ -309,10 +310,10 @@ pub(crate) fn residual_dots(
     });
 }
 
-/// `out = sum_k w[k] x_{cols[k]}` for the columns of the column-major `data` (`n` rows);
-/// `out.len() == n`, `w.len() == cols.len()`.
+/// `out = sum_k w[k] x_{cols[k]}` for the columns of the column-major `data` (column stride
+/// `n`, `out.len() <= n` rows), `w.len() == cols.len()`.
 pub(crate) fn combine(data: &[f64], n: usize, cols: &[usize], w: &[f64], out: &mut [f64]) {
-    debug_assert_eq!(out.len(), n);
+    debug_assert!(out.len() <= n);
     debug_assert_eq!(w.len(), cols.len());
     arch().dispatch(OverColumns {
         kernel: ColumnKernel::Combine,

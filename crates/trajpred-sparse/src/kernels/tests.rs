@@ -78,3 +78,31 @@ fn kernels_agree_with_plain_loops_on_awkward_sizes() {
         }
     }
 }
+
+#[test]
+fn column_kernels_read_rows_below_a_longer_column_stride() {
+    // columns of `n` rows stored `ld` apart (an aligned copy pads them): the padding, filled
+    // with NaN here, must never be read, and the results are those of the unpadded matrix
+    for &(n, p, ld) in &[(3, 2, 8), (17, 5, 24), (200, 9, 200), (515, 7, 520)] {
+        let x = matrix(n, p);
+        let mut padded = vec![f64::NAN; ld * p];
+        for j in 0..p {
+            padded[j * ld..j * ld + n].copy_from_slice(&x[j * n..(j + 1) * n]);
+        }
+        let v: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let cols: Vec<usize> = (0..p).rev().collect();
+        let (mut got, mut want) = (vec![0.0; p], vec![0.0; p]);
+        dots(&padded, ld, &cols, &v, &mut got);
+        dots(&x, n, &cols, &v, &mut want);
+        assert_eq!(got, want, "dots {n}x{p} ld {ld}");
+        let w: Vec<f64> = (0..p).map(|k| 1.0 - 0.3 * k as f64).collect();
+        let (mut got, mut want) = (vec![f64::NAN; n], vec![f64::NAN; n]);
+        combine(&padded, ld, &cols, &w, &mut got);
+        combine(&x, n, &cols, &w, &mut want);
+        assert_eq!(got, want, "combine {n}x{p} ld {ld}");
+        let (mut got, mut want) = (vec![f64::NAN; p], vec![f64::NAN; p]);
+        residual_dots(&padded, ld, &cols, &w, &v, &mut got);
+        residual_dots(&x, n, &cols, &w, &v, &mut want);
+        assert_eq!(got, want, "residual_dots {n}x{p} ld {ld}");
+    }
+}
