@@ -1,15 +1,26 @@
 //! Incremental Cholesky factor `G = L L^T` of the active Gram matrix: append a column
 //! (a variable enters), remove one (a lasso drop, by Givens rotations), and solve.
 //!
-//! Rows are stored separately (row `i` holds `L[i][0..=i]`), so both triangular solves
-//! run over contiguous memory and the factor grows without a capacity guess.
+//! The rows are packed in one line-aligned buffer from the thread's pool, each row starting
+//! on a 64-byte line (see [`kernels::Tri`]): both triangular solves run over contiguous,
+//! aligned memory, and a fit does not allocate a row per variable.
 
-use crate::kernels;
+use crate::kernels::{self, Tri, tri_offset};
+use crate::workspace::Aligned;
 
 /// Lower-triangular Cholesky factor of the Gram matrix of the active set.
-#[derive(Debug, Clone, Default)]
 pub(crate) struct CholeskyFactor {
-    rows: Vec<Vec<f64>>,
+    buf: Aligned,
+    len: usize,
+}
+
+impl Default for CholeskyFactor {
+    fn default() -> Self {
+        CholeskyFactor {
+            buf: Aligned::empty(),
+            len: 0,
+        }
+    }
 }
 
 /// Outcome of trying to append a column to the factor.
@@ -23,58 +34,108 @@ pub(crate) enum Append {
 }
 
 impl CholeskyFactor {
+    /// An empty factor with room for `rows` rows.
+    pub(crate) fn with_capacity(rows: usize) -> Self {
+        CholeskyFactor {
+            buf: Aligned::zeroed(tri_offset(rows)),
+            len: 0,
+        }
+    }
+
     /// Size of the factor (number of active variables).
     pub(crate) fn len(&self) -> usize {
-        self.rows.len()
+        self.len
+    }
+
+    fn tri(&self) -> Tri<'_> {
+        Tri {
+            data: self.buf.as_slice(),
+            len: self.len,
+        }
+    }
+
+    /// Row `i`, `L[i][0..=i]`.
+    fn row(&self, i: usize) -> &[f64] {
+        let o = tri_offset(i);
+        &self.buf.as_slice()[o..o + i + 1]
+    }
+
+    /// Room for one more row (doubling the room when it is full).
+    fn reserve_row(&mut self) {
+        let need = tri_offset(self.len + 1);
+        if self.buf.as_slice().len() < need {
+            let mut bigger = Aligned::zeroed(tri_offset(2 * self.len + 8));
+            let used = tri_offset(self.len);
+            bigger.as_mut_slice()[..used].copy_from_slice(&self.buf.as_slice()[..used]);
+            self.buf = bigger;
+        }
     }
 
     /// Tries to append the variable whose Gram entries with the active set are `g` (in the
     /// factor's order) and whose own squared norm is `gjj`.
     pub(crate) fn append(&mut self, g: &[f64], gjj: f64, tolerance: f64) -> Append {
         debug_assert_eq!(g.len(), self.len());
-        // room for the diagonal entry too: the push below does not reallocate
-        let mut w = Vec::with_capacity(g.len() + 1);
-        w.extend_from_slice(g);
-        self.forward_in_place(&mut w);
-        let d2 = gjj - w.iter().map(|v| v * v).sum::<f64>();
+        let k = self.len;
+        self.reserve_row();
+        let o = tri_offset(k);
+        // the new row is solved in its own place, from the rows above it
+        let (above, rest) = self.buf.as_mut_slice().split_at_mut(o);
+        let w = &mut rest[..k + 1];
+        w[..k].copy_from_slice(g);
+        kernels::forward(
+            Tri {
+                data: above,
+                len: k,
+            },
+            &mut w[..k],
+        );
+        let d2 = gjj - w[..k].iter().map(|v| v * v).sum::<f64>();
         if !(d2.is_finite() && d2 > tolerance * gjj && gjj > 0.0) {
             return Append::Collinear;
         }
-        w.push(d2.sqrt());
-        self.rows.push(w);
+        w[k] = d2.sqrt();
+        self.len += 1;
         Append::Appended
     }
 
     /// Removes the variable at position `idx` (a lasso drop): the row is deleted and the
     /// resulting Hessenberg part is restored to triangular form with Givens rotations.
     pub(crate) fn remove(&mut self, idx: usize) {
-        if idx >= self.rows.len() {
+        if idx >= self.len {
             return;
         }
-        self.rows.remove(idx);
-        let k = self.rows.len();
+        // (rare: the rows are taken out, rotated as separate rows and packed again)
+        let mut rows: Vec<Vec<f64>> = (0..self.len).map(|i| self.row(i).to_vec()).collect();
+        rows.remove(idx);
+        let k = rows.len();
         for i in idx..k {
-            let a = self.rows[i][i];
-            let b = self.rows[i][i + 1];
+            let a = rows[i][i];
+            let b = rows[i][i + 1];
             let r = a.hypot(b);
             let (c, s) = if r > 0.0 { (a / r, b / r) } else { (1.0, 0.0) };
-            for row in &mut self.rows[i..] {
+            for row in &mut rows[i..] {
                 let (x, y) = (row[i], row[i + 1]);
                 row[i] = c * x + s * y;
                 row[i + 1] = -s * x + c * y;
             }
-            self.rows[i].truncate(i + 1);
+            rows[i].truncate(i + 1);
         }
+        let data = self.buf.as_mut_slice();
+        for (i, row) in rows.iter().enumerate() {
+            let o = tri_offset(i);
+            data[o..o + i + 1].copy_from_slice(row);
+        }
+        self.len = k;
     }
 
     /// Extends `z = L^{-1} b`, solved for the factor without its last row, by the entry of
     /// that row (`b_last` the matching entry of `b`): bit for bit what a full forward solve
     /// gives, in `O(len)` instead of `O(len^2)`.
     pub(crate) fn forward_extend(&self, z: &mut Vec<f64>, b_last: f64) {
-        let Some(row) = self.rows.last() else {
+        let Some(k) = self.len.checked_sub(1) else {
             return;
         };
-        let k = row.len() - 1;
+        let row = self.row(k);
         debug_assert_eq!(z.len(), k);
         let s = kernels::forward_dot(row, z, k);
         z.push((b_last - s) / row[k]);
@@ -82,12 +143,12 @@ impl CholeskyFactor {
 
     /// Solves `L z = b` in place.
     pub(crate) fn forward_in_place(&self, b: &mut [f64]) {
-        kernels::forward(&self.rows, b);
+        kernels::forward(self.tri(), b);
     }
 
     /// Solves `L^T x = z` in place.
     pub(crate) fn backward_in_place(&self, z: &mut [f64]) {
-        kernels::backward(&self.rows, z);
+        kernels::backward(self.tri(), z);
     }
 
     /// Solves `G x = b` in place.

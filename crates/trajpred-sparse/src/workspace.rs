@@ -92,6 +92,15 @@ impl Aligned {
         Aligned { buf, off, len }
     }
 
+    /// No room at all (no buffer taken from the pool).
+    pub(crate) fn empty() -> Self {
+        Aligned {
+            buf: Vec::new(),
+            off: 0,
+            len: 0,
+        }
+    }
+
     pub(crate) fn as_slice(&self) -> &[f64] {
         &self.buf[self.off..self.off + self.len]
     }

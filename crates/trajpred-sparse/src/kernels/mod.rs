@@ -328,6 +328,29 @@ pub(crate) fn combine(data: &[f64], n: usize, cols: &[usize], w: &[f64], out: &m
 // ---------------------------------------------------------------------------------------
 // triangular solves with a row-stored lower-triangular factor
 
+/// A lower-triangular factor stored by rows, each row starting on a whole number of 8-value
+/// lines from the start of `data` (row `i`, `L[i][0..=i]`, at [`tri_offset`]`(i)`): a
+/// 64-byte aligned `data` makes every row's vector loads aligned.
+#[derive(Clone, Copy)]
+pub(crate) struct Tri<'a> {
+    pub(crate) data: &'a [f64],
+    pub(crate) len: usize,
+}
+
+/// Where row `i` of a [`Tri`] starts: rows `0..i` take `ceil((r + 1) / 8)` lines of 8 each.
+pub(crate) const fn tri_offset(i: usize) -> usize {
+    let (a, b) = (i / 8, i % 8);
+    8 * (a + 1) * (4 * a + b)
+}
+
+impl<'a> Tri<'a> {
+    #[inline(always)]
+    fn row(&self, i: usize) -> &'a [f64] {
+        let o = tri_offset(i);
+        &self.data[o..o + i + 1]
+    }
+}
+
 /// Rows per block of the forward solve: the dot products of a block's rows with the part of
 /// the solution solved before the block are independent, so they overlap in the pipeline
 /// instead of waiting for each other's reductions.
@@ -346,7 +369,7 @@ fn forward_dot_with<S: Simd>(simd: S, row: &[f64], b: &[f64], i: usize) -> f64 {
 }
 
 struct Forward<'a> {
-    rows: &'a [Vec<f64>],
+    rows: Tri<'a>,
     b: &'a mut [f64],
 }
 
@@ -356,16 +379,16 @@ impl WithSimd for Forward<'_> {
     fn with_simd<S: Simd>(self, simd: S) {
         let Forward { rows, b } = self;
         let mut i0 = 0;
-        while i0 < rows.len() {
-            let i1 = (i0 + SOLVE_BLOCK).min(rows.len());
+        while i0 < rows.len {
+            let i1 = (i0 + SOLVE_BLOCK).min(rows.len);
             // the block's dot products with b[..i0] first, all at once (a short last block
             // repeats its last row) ...
-            let block = &rows[i0..i1];
             let heads: [&[f64]; SOLVE_BLOCK] =
-                std::array::from_fn(|k| &block[k.min(block.len() - 1)][..i0]);
+                std::array::from_fn(|k| &rows.row((i0 + k).min(i1 - 1))[..i0]);
             let head = row_dots_with(simd, heads, &b[..i0]);
             // ... then the triangle inside the block, in order (= forward_dot_with)
-            for (i, row) in rows.iter().enumerate().take(i1).skip(i0) {
+            for i in i0..i1 {
+                let row = rows.row(i);
                 let mut s = head[i - i0];
                 for (r, x) in row[i0..i].iter().zip(&b[i0..i]) {
                     s += r * x;
@@ -377,9 +400,8 @@ impl WithSimd for Forward<'_> {
     }
 }
 
-/// Solves `L z = b` in place, `rows[i]` holding `L[i][0..=i]` (one dispatch for the whole
-/// solve).
-pub(crate) fn forward(rows: &[Vec<f64>], b: &mut [f64]) {
+/// Solves `L z = b` in place (one dispatch for the whole solve).
+pub(crate) fn forward(rows: Tri<'_>, b: &mut [f64]) {
     arch().dispatch(Forward { rows, b });
 }
 
@@ -402,7 +424,7 @@ pub(crate) fn forward_dot(row: &[f64], b: &[f64], i: usize) -> f64 {
 const BACK_GROUP: usize = 4;
 
 struct Backward<'a> {
-    rows: &'a [Vec<f64>],
+    rows: Tri<'a>,
     z: &'a mut [f64],
 }
 
@@ -414,11 +436,11 @@ impl WithSimd for Backward<'_> {
         // groups of BACK_GROUP rows from the bottom of the factor: the triangle inside a group
         // in order, then the group's rows leave the entries above it in one pass over `z`
         // (each entry takes the rows' products in the same order as row by row)
-        let mut i1 = rows.len();
+        let mut i1 = rows.len;
         while i1 > 0 {
             let g0 = i1.saturating_sub(BACK_GROUP);
             for i in (g0..i1).rev() {
-                let row = &rows[i];
+                let row = rows.row(i);
                 let xi = z[i] / row[i];
                 z[i] = xi;
                 for (zj, rj) in z[g0..i].iter_mut().zip(&row[g0..i]) {
@@ -427,7 +449,7 @@ impl WithSimd for Backward<'_> {
             }
             if g0 > 0 {
                 // a full group (only the top rows of the factor make a short one, at g0 = 0)
-                let rs: [&[f64]; BACK_GROUP] = std::array::from_fn(|k| &rows[i1 - 1 - k][..g0]);
+                let rs: [&[f64]; BACK_GROUP] = std::array::from_fn(|k| &rows.row(i1 - 1 - k)[..g0]);
                 let xs: [f64; BACK_GROUP] = std::array::from_fn(|k| z[i1 - 1 - k]);
                 let mut nx = [simd.splat_f64s(0.0); BACK_GROUP];
                 for k in 0..BACK_GROUP {
@@ -455,8 +477,8 @@ impl WithSimd for Backward<'_> {
     }
 }
 
-/// Solves `L^T x = z` in place, `rows[i]` holding `L[i][0..=i]`.
-pub(crate) fn backward(rows: &[Vec<f64>], z: &mut [f64]) {
+/// Solves `L^T x = z` in place.
+pub(crate) fn backward(rows: Tri<'_>, z: &mut [f64]) {
     arch().dispatch(Backward { rows, z });
 }
 

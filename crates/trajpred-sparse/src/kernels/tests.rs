@@ -106,3 +106,13 @@ fn column_kernels_read_rows_below_a_longer_column_stride() {
         assert_eq!(got, want, "residual_dots {n}x{p} ld {ld}");
     }
 }
+
+#[test]
+fn packed_factor_rows_start_on_lines_and_do_not_overlap() {
+    for i in 0..100 {
+        let (o, next) = (tri_offset(i), tri_offset(i + 1));
+        assert_eq!(o % 8, 0, "row {i} starts on a line");
+        assert!(next > o + i, "row {i} fits before row {}", i + 1);
+        assert!(next - o < i + 1 + 8, "row {i} wastes less than a line");
+    }
+}

@@ -271,7 +271,7 @@ impl<'a> Core<'a> {
         let mut events = Vec::new();
         let mut active: Vec<usize> = Vec::new();
         let mut signs: Vec<f64> = Vec::new();
-        let mut chol = CholeskyFactor::default();
+        let mut chol = CholeskyFactor::with_capacity(self.n.min(p));
         // z = L^{-1} s, extended on each entry, recomputed after drops (the downdate changes L)
         let mut z: Vec<f64> = Vec::new();
         let mut z_stale = false;
