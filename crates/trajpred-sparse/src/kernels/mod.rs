@@ -483,7 +483,9 @@ pub(crate) fn backward(rows: Tri<'_>, z: &mut [f64]) {
 }
 
 mod gram;
+pub(crate) mod step;
 pub(crate) use gram::gram;
+pub(crate) use step::step_min;
 
 #[cfg(test)]
 mod tests;

@@ -116,3 +116,34 @@ fn packed_factor_rows_start_on_lines_and_do_not_overlap() {
         assert!(next - o < i + 1 + 8, "row {i} wastes less than a line");
     }
 }
+
+#[test]
+fn step_length_kernel_equals_the_plain_loop() {
+    // lengths around the vector widths; signs, zeros, ties and a NaN in the correlations
+    for len in [0usize, 1, 3, 7, 8, 9, 17, 64, 1001] {
+        let c: Vec<f64> = (0..len)
+            .map(|k| match k % 11 {
+                0 => 0.0,
+                5 => 2.0,  // |c| = C: one side has a zero numerator
+                7 => -3.0, // |c| > C: one side has a negative numerator
+                9 if len > 100 => f64::NAN,
+                _ => ((k * 37 % 101) as f64 - 50.0) / 30.0,
+            })
+            .collect();
+        let a: Vec<f64> = (0..len)
+            .map(|k| match k % 13 {
+                3 => 1.5, // a = AA: a zero denominator
+                _ => ((k * 53 % 97) as f64 - 48.0) / 20.0,
+            })
+            .collect();
+        for &(big_c, aa, gamma_hat) in &[
+            (2.0, 1.5, 2.0 / 1.5),
+            (2.0, 0.25, 8.0),
+            (1e-3, 3.0, 1e-3 / 3.0),
+        ] {
+            let want = step::step_min_plain(&c, &a, big_c, aa, gamma_hat);
+            let got = step_min(&c, &a, big_c, aa, gamma_hat);
+            assert_eq!(got.to_bits(), want.to_bits(), "len {len} C {big_c} AA {aa}");
+        }
+    }
+}

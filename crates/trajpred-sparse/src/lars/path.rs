@@ -283,6 +283,7 @@ impl<'a> Core<'a> {
         let mut w: Vec<f64> = Vec::new();
         let mut drops: Vec<usize> = Vec::new(); // positions in `active`
         let mut a = vec![0.0; p];
+        let mut c_listed: Vec<f64> = Vec::with_capacity(p);
 
         let finish = |alphas, coefs, events, active, stop, chol| Path {
             alphas,
@@ -399,7 +400,28 @@ impl<'a> Core<'a> {
             let mut gamma = gamma_hat;
             // `self.inactive`: the eligible inactive columns, listed for the correlations
             let any_inactive = !self.inactive.is_empty();
-            for &j in &self.inactive {
+            // the same minimum by a vector kernel over the correlations as they were listed
+            // (with `c` gathered in that order), unless a variable was just dropped
+            let listed: &[usize] = if just_dropped.is_empty() {
+                if self.gram.is_some() {
+                    &self.inactive
+                } else {
+                    &self.order
+                }
+            } else {
+                &[]
+            };
+            if !listed.is_empty() {
+                c_listed.clear();
+                c_listed.extend(listed.iter().map(|&j| c[j]));
+                gamma = kernels::step_min(&c_listed, &self.a_inactive, big_c, aa, gamma_hat);
+            }
+            let scalar: &[usize] = if listed.is_empty() {
+                &self.inactive
+            } else {
+                &[]
+            };
+            for &j in scalar {
                 let dropped_now = just_dropped.contains(&j);
                 for side in [1.0, -1.0] {
                     // a just-dropped variable sits exactly at |c_j| = C on its own side
