@@ -482,8 +482,10 @@ pub(crate) fn backward(rows: Tri<'_>, z: &mut [f64]) {
     arch().dispatch(Backward { rows, z });
 }
 
+mod dots2;
 mod gram;
 pub(crate) mod step;
+pub(crate) use dots2::dots2;
 pub(crate) use gram::gram;
 pub(crate) use step::step_min;
 

@@ -147,3 +147,27 @@ fn step_length_kernel_equals_the_plain_loop() {
         }
     }
 }
+
+#[test]
+fn two_vector_dots_equal_two_single_passes_bit_for_bit() {
+    for &(n, p, ld) in &[
+        (1, 1, 1),
+        (3, 6, 8),
+        (17, 5, 24),
+        (200, 11, 200),
+        (515, 9, 520),
+    ] {
+        let x = matrix(ld, p);
+        let v: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let v2: Vec<f64> = (0..n).map(|i| (i as f64 * 0.11).cos() - 0.2).collect();
+        let cols: Vec<usize> = (0..p).rev().collect();
+        let (mut got, mut got2) = (vec![f64::NAN; p], vec![f64::NAN; p]);
+        dots2(&x, ld, &cols, (&v, &v2), &mut got, &mut got2);
+        let (mut want, mut want2) = (vec![0.0; p], vec![0.0; p]);
+        dots(&x, ld, &cols, &v, &mut want);
+        dots(&x, ld, &cols, &v2, &mut want2);
+        let bits = |s: &[f64]| s.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&got), bits(&want), "v {n}x{p} ld {ld}");
+        assert_eq!(bits(&got2), bits(&want2), "v2 {n}x{p} ld {ld}");
+    }
+}

@@ -57,7 +57,34 @@ pub(super) struct Core<'a> {
     /// `X`, and whether it runs from the last column.
     order: Vec<usize>,
     backwards: bool,
+    /// Without the Gram matrix, on a LAR path: `x_a . x_j` saved for the active variables
+    /// `a` and the columns `j` still inactive (see [`Saved`]).
+    saved: Saved,
 }
+
+/// The products of each active variable with the columns inactive when it entered, taken in
+/// the pass over `X` of the step it entered (one pass for `X_I^T u` and `X_I^T x_a`), so that
+/// a variable entering later finds its products with the active set here instead of in
+/// another pass over `X_A`. Bit for bit the same products (`x_a . x_j` and `x_j . x_a` are
+/// the same chains of the same products). Row `j` of `g` (`cap` values) holds `x_a . x_j` for
+/// the active positions `0..have`; off after a step where several variables entered, and on
+/// a lasso path (its drops reorder the active set).
+struct Saved {
+    on: bool,
+    g: Vec<f64>,
+    cap: usize,
+    have: usize,
+    new: Vec<f64>,
+}
+
+impl Drop for Saved {
+    fn drop(&mut self) {
+        crate::workspace::recycle(std::mem::take(&mut self.g));
+    }
+}
+
+/// Largest table of [`Saved`] products (bytes).
+const SAVED_BYTES: usize = 16 << 20;
 
 impl<'a> Core<'a> {
     /// With `use_gram`, `X^T X` and `X^T ys` are computed here, in one pass over `X`.
@@ -100,6 +127,13 @@ impl<'a> Core<'a> {
             pos_of: (0..p).collect(),
             order: Vec::with_capacity(if use_gram { 0 } else { p }),
             backwards: false,
+            saved: Saved {
+                on: false,
+                g: Vec::new(),
+                cap: 0,
+                have: 0,
+                new: Vec::new(),
+            },
         }
     }
 
@@ -119,6 +153,10 @@ impl<'a> Core<'a> {
             Some(g) => {
                 let g = g.as_slice();
                 out.extend(active.iter().map(|&a| g[j * self.ld + self.pos_of[a]]));
+            }
+            None if self.saved.on && self.saved.have == active.len() => {
+                let o = j * self.saved.cap;
+                out.extend_from_slice(&self.saved.g[o..o + active.len()]);
             }
             None => {
                 out.resize(active.len(), 0.0);
@@ -177,7 +215,31 @@ impl<'a> Core<'a> {
                 } else {
                     self.order.extend_from_slice(&self.inactive);
                 }
-                kernels::dots(data, self.ldx, &self.order, &self.u, &mut self.a_inactive);
+                let k = active.len();
+                if self.saved.on && k == self.saved.have + 1 && self.saved.have < self.saved.cap {
+                    // the variable that entered last: its products with the inactive columns
+                    // from the same pass, for when one of them enters
+                    let f = active[self.saved.have];
+                    let xf = &data[f * self.ldx..f * self.ldx + self.n];
+                    self.saved.new.resize(self.order.len(), 0.0);
+                    kernels::dots2(
+                        data,
+                        self.ldx,
+                        &self.order,
+                        (&self.u, xf),
+                        &mut self.a_inactive,
+                        &mut self.saved.new,
+                    );
+                    let (cap, have) = (self.saved.cap, self.saved.have);
+                    for (&j, &v) in self.order.iter().zip(&self.saved.new) {
+                        self.saved.g[j * cap + have] = v;
+                    }
+                    self.saved.have += 1;
+                } else {
+                    // (several variables entered together, or no room: not saved from here)
+                    self.saved.on &= k == self.saved.have;
+                    kernels::dots(data, self.ldx, &self.order, &self.u, &mut self.a_inactive);
+                }
                 a.fill(0.0);
                 for (&j, &v) in self.order.iter().zip(&self.a_inactive) {
                     a[j] = v;
@@ -256,6 +318,17 @@ impl<'a> Core<'a> {
         }
         self.inactive.clear();
         self.inactive.extend((0..p).filter(|&j| eligible[j]));
+        let cap = self.n.min(p);
+        if self.gram.is_none()
+            && params.method == Method::Lar
+            && p * cap * size_of::<f64>() <= SAVED_BYTES
+        {
+            // (never read before written: no need for zeros, but the pool gives them)
+            self.saved.g = crate::workspace::zeroed(p * cap);
+            self.saved.cap = cap;
+            self.saved.have = 0;
+            self.saved.on = true;
+        }
         let c0 = self
             .inactive
             .iter()
