@@ -1,7 +1,9 @@
 //! `aligned-gbm`: gradient-boosted trees that correct the last velocity, learned in the
 //! heading-aligned frame of `aligned-ridge` (issue 27).
 
+use super::fitted::At;
 use super::invalid;
+use super::trees::Ensemble;
 use forust_ml::gradientbooster::{GrowPolicy, MissingNodeTreatment};
 use forust_ml::objective::ObjectiveType;
 use forust_ml::sampler::SampleMethod;
@@ -306,8 +308,8 @@ fn fit_booster(
 /// ```
 pub struct AlignedGbm {
     params: AlignedGbmParams,
-    /// Per step, the along- and across-track boosters; empty before fitting.
-    models: Vec<[GradientBooster; 2]>,
+    /// Per step, the along- and across-track tree ensembles; empty before fitting.
+    models: Vec<[Ensemble; 2]>,
     /// Training origins per step (after the stride), for the summary.
     samples: Vec<usize>,
 }
@@ -367,11 +369,12 @@ impl Predictor for AlignedGbm {
         }
         let p = &self.params;
         let jobs: Vec<(usize, usize)> = (0..steps.len()).flat_map(|s| [(s, 0), (s, 1)]).collect();
-        let boosters: Vec<GradientBooster> = jobs
+        let boosters: Vec<Ensemble> = jobs
             .par_iter()
             .map(|&(s, axis)| {
                 let (data, rows, targets) = &steps[s];
-                fit_booster(p, data, *rows, &targets[axis])
+                let b = fit_booster(p, data, *rows, &targets[axis])?;
+                Ok(Ensemble::from_booster(&b, p.features()))
             })
             .collect::<Result<_>>()?;
         let mut it = boosters.into_iter();
@@ -421,7 +424,6 @@ impl Predictor for AlignedGbm {
         }
         let (x, y) = xy(history);
         let org = Origin::new(&self.params, t, x, &y, n - 1);
-        let row = Matrix::new(&org.feats, 1, org.feats.len());
         let last = history.last_point();
         let steps: Vec<Vec<f64>> = times
             .iter()
@@ -430,10 +432,7 @@ impl Predictor for AlignedGbm {
             .map(|(i, (&at, [along, across]))| {
                 let tau = at - t[n - 1];
                 let scale = tau / ((i + 1) as f64 * org.delta);
-                let c = (
-                    along.predict(&row, false)[0],
-                    across.predict(&row, false)[0],
-                );
+                let c = (along.predict(&org.feats), across.predict(&org.feats));
                 let (dx, dy) =
                     org.unrotate((tau * org.v0.0 + scale * c.0, tau * org.v0.1 + scale * c.1));
                 let mut p = vec![last[0] + dx];
@@ -456,15 +455,19 @@ impl Predictor for AlignedGbm {
     }
 
     /// `{"lags", "window", "horizons"}` (checked against this predictor's parameters on
-    /// loading) and `"models"`: per step, the along- and across-track boosters in
-    /// `forust-ml`'s own serialisation.
+    /// loading) and `"models"`: per step, the along- and across-track tree ensembles
+    /// (`{"base", "trees"}`, each tree node by node).
     fn fitted_params(&self) -> Result<serde_json::Value> {
         if self.models.is_empty() {
             return Err(Error::NotFitted {
                 method: NAME.into(),
             });
         }
-        let models = serde_json::to_value(&self.models).map_err(|e| Error::method(NAME, e))?;
+        let models: Vec<serde_json::Value> = self
+            .models
+            .iter()
+            .map(|[a, b]| serde_json::json!([a.to_json(), b.to_json()]))
+            .collect();
         let p = &self.params;
         Ok(serde_json::json!({
             "lags": p.lags,
@@ -475,39 +478,35 @@ impl Predictor for AlignedGbm {
     }
 
     fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
-        let bad = |path: &str, reason: String| Error::InvalidFitted {
-            method: NAME.into(),
-            path: path.into(),
-            reason,
-        };
+        let root = At::root(NAME, params);
+        let [lags, window, horizons, models] =
+            root.fields(["lags", "window", "horizons", "models"])?;
         let p = &self.params;
-        for (key, ours) in [
-            ("lags", p.lags),
-            ("window", p.window),
-            ("horizons", p.horizons),
+        for (at, ours, key) in [
+            (&lags, p.lags, "lags"),
+            (&window, p.window, "window"),
+            (&horizons, p.horizons, "horizons"),
         ] {
-            match params.get(key).and_then(serde_json::Value::as_u64) {
-                Some(v) if v == ours as u64 => {}
-                Some(v) => {
-                    return Err(bad(
-                        key,
-                        format!("fitted with {key} {v}, but this predictor has {key} {ours}"),
-                    ));
-                }
-                None => return Err(bad(key, "missing, or not a whole number".into())),
+            let saved = at.f64()?;
+            if saved != ours as f64 {
+                return Err(at.error(format!(
+                    "fitted with {key} {saved}, but this predictor has {key} {ours}"
+                )));
             }
         }
-        let models: Vec<[GradientBooster; 2]> = params
-            .get("models")
-            .cloned()
-            .ok_or_else(|| bad("models", "missing".into()))
-            .and_then(|m| serde_json::from_value(m).map_err(|e| bad("models", e.to_string())))?;
-        if models.len() != p.horizons {
-            return Err(bad(
-                "models",
-                format!("{} steps, expected {}", models.len(), p.horizons),
-            ));
-        }
+        let max_trees = 1 << 20;
+        let models = models
+            .items(Some(p.horizons), p.horizons)?
+            .iter()
+            .map(|step| {
+                let [a, b] = <[At<'_>; 2]>::try_from(step.items(Some(2), 2)?)
+                    .map_err(|_| step.error("expected 2 ensembles"))?;
+                Ok([
+                    Ensemble::from_json(&a, p.features(), max_trees)?,
+                    Ensemble::from_json(&b, p.features(), max_trees)?,
+                ])
+            })
+            .collect::<Result<Vec<_>>>()?;
         self.models = models;
         self.samples.clear();
         Ok(())
@@ -520,7 +519,7 @@ impl Predictor for AlignedGbm {
         let trees: Vec<String> = self
             .models
             .iter()
-            .map(|[a, b]| format!("{}+{}", a.trees.len(), b.trees.len()))
+            .map(|[a, b]| format!("{}+{}", a.trees(), b.trees()))
             .collect();
         Some(format!(
             "trees per step (along+across) {}; training origins per step {:?}",

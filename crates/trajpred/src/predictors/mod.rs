@@ -13,6 +13,7 @@ mod kf_dynamic;
 mod kf_time;
 mod particle;
 mod poly;
+mod trees;
 
 pub use aligned_gbm::{AlignedGbm, AlignedGbmParams};
 pub use aligned_ridge::{AlignedRidge, AlignedRidgeParams};
