@@ -401,27 +401,9 @@ impl Predictor for AlignedGbm {
                 method: NAME.into(),
             });
         }
-        if times.len() > self.models.len() {
-            return Err(invalid(
-                "horizon",
-                format!(
-                    "{NAME} was fitted for {} steps, asked for {}",
-                    self.models.len(),
-                    times.len()
-                ),
-            ));
-        }
+        super::check_fitted_times(NAME, self.models.len(), history, times)?;
         let n = history.len();
         let t = history.times();
-        if let Some(&bad) = times.iter().find(|&&x| !(x.is_finite() && x > t[n - 1])) {
-            return Err(invalid(
-                "times",
-                format!(
-                    "forecast times must be after the history's end {}, got {bad}",
-                    t[n - 1]
-                ),
-            ));
-        }
         let (x, y) = xy(history);
         let org = Origin::new(&self.params, t, x, &y, n - 1);
         let last = history.last_point();

@@ -479,27 +479,9 @@ impl Predictor for AlignedRidge {
                 method: "aligned-ridge".into(),
             });
         }
-        if times.len() > self.params.horizons {
-            return Err(invalid(
-                "horizon",
-                format!(
-                    "aligned-ridge was fitted for {} steps, asked for {}",
-                    self.params.horizons,
-                    times.len()
-                ),
-            ));
-        }
+        super::check_fitted_times("aligned-ridge", self.params.horizons, history, times)?;
         let n = history.len();
         let t = history.times();
-        if let Some(&bad) = times.iter().find(|&&x| !(x.is_finite() && x > t[n - 1])) {
-            return Err(invalid(
-                "times",
-                format!(
-                    "forecast times must be after the history's end {}, got {bad}",
-                    t[n - 1]
-                ),
-            ));
-        }
         let (x, y) = xy(history);
         let frame = Frame::new(t, x, &y, n - 1, self.params.lags);
         let last = history.last_point();

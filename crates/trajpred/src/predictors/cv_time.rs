@@ -1,7 +1,7 @@
 //! A reference method for every leaderboard: constant velocity from the last two points,
 //! aware of their time difference.
 
-use super::{invalid, step_interval};
+use super::step_interval;
 use serde::{Deserialize, Serialize};
 use trajpred_core::{Forecast, Predictor, Result, Trajectory, check_forecast_args};
 
@@ -79,15 +79,7 @@ impl Predictor for CvTime {
         let t = history.times();
         // timestamps strictly increase (a `Trajectory` invariant), so this is positive
         let leg = t[n - 1] - t[n - 2];
-        if let Some(&bad) = times.iter().find(|&&x| !(x.is_finite() && x > t[n - 1])) {
-            return Err(invalid(
-                "times",
-                format!(
-                    "forecast times must be after the history's end {}, got {bad}",
-                    t[n - 1]
-                ),
-            ));
-        }
+        super::check_times_after(history, times)?;
         let (last, prev) = (history.point(n - 1), history.point(n - 2));
         let steps: Vec<Vec<f64>> = times
             .iter()

@@ -92,6 +92,40 @@ pub(crate) fn offsets_after(history: &Trajectory, times: &[f64]) -> Result<Vec<f
     Ok(times.iter().map(|&t| t - last).collect())
 }
 
+/// The checks of a fitted multi-step model's `forecast_times`: at most `fitted` steps, every
+/// time finite and after the history's end; the errors name `horizon` or `times`.
+pub(crate) fn check_fitted_times(
+    method: &str,
+    fitted: usize,
+    history: &Trajectory,
+    times: &[f64],
+) -> Result<()> {
+    if times.len() > fitted {
+        return Err(invalid(
+            "horizon",
+            format!(
+                "{method} was fitted for {fitted} steps, asked for {}",
+                times.len()
+            ),
+        ));
+    }
+    check_times_after(history, times)
+}
+
+/// Every forecast time finite and after the history's end (an error naming `times`).
+pub(crate) fn check_times_after(history: &Trajectory, times: &[f64]) -> Result<()> {
+    let Some(&end) = history.times().last() else {
+        return Err(Error::Empty { what: "history" });
+    };
+    match times.iter().find(|&&x| !(x.is_finite() && x > end)) {
+        Some(&bad) => Err(invalid(
+            "times",
+            format!("forecast times must be after the history's end {end}, got {bad}"),
+        )),
+        None => Ok(()),
+    }
+}
+
 /// Each trajectory its own group: what `fit` without groups means for the methods that
 /// cross-validate by group.
 pub(crate) fn own_groups(train: &[Trajectory]) -> Vec<usize> {
