@@ -406,7 +406,6 @@ impl Predictor for AlignedGbm {
         let t = history.times();
         let (x, y) = xy(history);
         let org = Origin::new(&self.params, t, x, &y, n - 1);
-        let last = history.last_point();
         let steps: Vec<Vec<f64>> = times
             .iter()
             .zip(&self.models)
@@ -417,16 +416,7 @@ impl Predictor for AlignedGbm {
                 let c = (along.predict(&org.feats), across.predict(&org.feats));
                 let (dx, dy) =
                     org.unrotate((tau * org.v0.0 + scale * c.0, tau * org.v0.1 + scale * c.1));
-                let mut p = vec![last[0] + dx];
-                if history.dim() >= 2 {
-                    p.push(last[1] + dy);
-                }
-                if history.dim() >= 3 {
-                    let leg = t[n - 1] - t[n - 2];
-                    let vz = (last[2] - history.point(n - 2)[2]) / leg;
-                    p.push(last[2] + vz * tau);
-                }
-                p
+                super::displaced_point(history, (dx, dy), tau)
             })
             .collect();
         Forecast::new(history.dim(), steps)

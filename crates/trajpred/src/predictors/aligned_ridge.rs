@@ -484,7 +484,6 @@ impl Predictor for AlignedRidge {
         let t = history.times();
         let (x, y) = xy(history);
         let frame = Frame::new(t, x, &y, n - 1, self.params.lags);
-        let last = history.last_point();
         let mut row = Vec::with_capacity(self.params.features());
         let steps: Vec<Vec<f64>> = times
             .iter()
@@ -499,15 +498,7 @@ impl Predictor for AlignedRidge {
                     b += r * w[(i, 1)];
                 }
                 let (dx, dy) = frame.unrotate((a, b));
-                let mut p = vec![last[0] + dx];
-                if history.dim() >= 2 {
-                    p.push(last[1] + dy);
-                }
-                if history.dim() >= 3 {
-                    let vz = (last[2] - history.point(n - 2)[2]) / frame.leg;
-                    p.push(last[2] + vz * tau);
-                }
-                p
+                super::displaced_point(history, (dx, dy), tau)
             })
             .collect();
         Forecast::new(history.dim(), steps)

@@ -126,6 +126,24 @@ pub(crate) fn check_times_after(history: &Trajectory, times: &[f64]) -> Result<(
     }
 }
 
+/// The point `tau` seconds after the end of `history` that a horizontal displacement
+/// `(dx, dy)` reaches (`dy` dropped for 1-D tracks); a third axis (altitude) follows its last
+/// velocity. Needs at least two history points for 3-D tracks.
+pub(crate) fn displaced_point(history: &Trajectory, (dx, dy): (f64, f64), tau: f64) -> Vec<f64> {
+    let n = history.len();
+    let last = history.last_point();
+    let mut p = vec![last[0] + dx];
+    if history.dim() >= 2 {
+        p.push(last[1] + dy);
+    }
+    if history.dim() >= 3 && n >= 2 {
+        let t = history.times();
+        let vz = (last[2] - history.point(n - 2)[2]) / (t[n - 1] - t[n - 2]);
+        p.push(last[2] + vz * tau);
+    }
+    p
+}
+
 /// Each trajectory its own group: what `fit` without groups means for the methods that
 /// cross-validate by group.
 pub(crate) fn own_groups(train: &[Trajectory]) -> Vec<usize> {
