@@ -2,8 +2,8 @@
 //! heading-aligned frame of `aligned-ridge` (issue 27).
 
 use super::fitted::At;
-use super::invalid;
 use super::trees::Ensemble;
+use super::{Heading, horizontal_axes as xy, invalid};
 use forust_ml::gradientbooster::{GrowPolicy, MissingNodeTreatment};
 use forust_ml::objective::ObjectiveType;
 use forust_ml::sampler::SampleMethod;
@@ -115,8 +115,8 @@ impl AlignedGbmParams {
 
 /// One origin described in the frame where its last velocity points along +x.
 struct Origin {
-    /// Unit heading `(cos, sin)`.
-    u: (f64, f64),
+    /// The heading.
+    u: Heading,
     /// The last velocity, rotated (`(|v0|, 0)` unless it is zero).
     v0: (f64, f64),
     /// The mean interval of the window, s.
@@ -137,12 +137,8 @@ impl Origin {
             )
         };
         let legs: Vec<(f64, f64, f64)> = (0..p.lags).map(vel).collect();
-        let u = legs
-            .iter()
-            .map(|&(a, b, _)| (a, b, a.hypot(b)))
-            .find(|&(_, _, s)| s > 1e-9)
-            .map_or((1.0, 0.0), |(a, b, s)| (a / s, b / s));
-        let rot = |a: f64, b: f64| (u.0 * a + u.1 * b, u.0 * b - u.1 * a);
+        let u = Heading::of(&legs.iter().map(|&(a, b, _)| (a, b)).collect::<Vec<_>>());
+        let rot = |a: f64, b: f64| u.rotate((a, b));
         let first = o + 1 - p.window.min(o + 1);
         let span = t[o] - t[first];
         let delta = span / (o - first) as f64;
@@ -164,18 +160,9 @@ impl Origin {
     }
 
     /// Rotates an aligned displacement back to the data's axes.
-    fn unrotate(&self, (a, b): (f64, f64)) -> (f64, f64) {
-        (self.u.0 * a - self.u.1 * b, self.u.1 * a + self.u.0 * b)
+    fn unrotate(&self, d: (f64, f64)) -> (f64, f64) {
+        self.u.unrotate(d)
     }
-}
-
-fn xy(tr: &Trajectory) -> (&[f64], Vec<f64>) {
-    let y = if tr.dim() >= 2 {
-        tr.axis(1).to_vec()
-    } else {
-        vec![0.0; tr.len()]
-    };
-    (tr.axis(0), y)
 }
 
 /// Training samples of one step: features row by row, and the two normalised targets.
@@ -197,12 +184,10 @@ fn samples(p: &AlignedGbmParams, tr: &Trajectory, s: usize, into: &mut Samples) 
         let org = Origin::new(p, t, x, &y, o);
         let tau = t[o + s] - t[o];
         let d = (x[o + s] - x[o], y[o + s] - y[o]);
-        let (u0, u1) = org.u;
+        let r = org.u.rotate(d);
         let scale = s as f64 * org.delta / tau;
-        into.along
-            .push((u0 * d.0 + u1 * d.1 - tau * org.v0.0) * scale);
-        into.across
-            .push((u0 * d.1 - u1 * d.0 - tau * org.v0.1) * scale);
+        into.along.push((r.0 - tau * org.v0.0) * scale);
+        into.across.push((r.1 - tau * org.v0.1) * scale);
         into.rows.push(org.feats);
     }
 }

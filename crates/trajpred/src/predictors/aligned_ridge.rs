@@ -3,7 +3,7 @@
 
 use super::auto::{fold_of_trajectories, fold_split};
 use super::fitted::{At, exact, exact_matrix, exact_vec};
-use super::invalid;
+use super::{Heading, horizontal_axes as xy, invalid};
 use crate::harness::{self, EvalConfig};
 use nalgebra::DMatrix;
 use rayon::prelude::*;
@@ -129,8 +129,8 @@ impl AlignedRidgeParams {
 /// The horizontal (first two axes) view of a history ending at `o`, in the frame where the
 /// last velocity points along +x.
 struct Frame {
-    /// Unit heading `(cos, sin)`.
-    u: (f64, f64),
+    /// The heading.
+    u: Heading,
     /// The rotated velocities, newest first, and the last speed.
     feats: Vec<f64>,
     /// The last velocity, rotated.
@@ -150,12 +150,8 @@ impl Frame {
             )
         };
         let vs: Vec<(f64, f64)> = (0..lags).map(vel).collect();
-        let u = vs
-            .iter()
-            .map(|&(a, b)| (a, b, a.hypot(b)))
-            .find(|&(_, _, s)| s > 1e-9)
-            .map_or((1.0, 0.0), |(a, b, s)| (a / s, b / s));
-        let rot = |(a, b): (f64, f64)| (u.0 * a + u.1 * b, u.0 * b - u.1 * a);
+        let u = Heading::of(&vs);
+        let rot = |v| u.rotate(v);
         let mut feats = Vec::with_capacity(2 * lags);
         for &v in &vs {
             let (a, b) = rot(v);
@@ -178,8 +174,8 @@ impl Frame {
     }
 
     /// Rotates an aligned displacement back to the data's axes.
-    fn unrotate(&self, (a, b): (f64, f64)) -> (f64, f64) {
-        (self.u.0 * a - self.u.1 * b, self.u.1 * a + self.u.0 * b)
+    fn unrotate(&self, d: (f64, f64)) -> (f64, f64) {
+        self.u.unrotate(d)
     }
 }
 
@@ -206,15 +202,6 @@ impl Normal {
     }
 }
 
-fn xy(tr: &Trajectory) -> (&[f64], Vec<f64>) {
-    let y = if tr.dim() >= 2 {
-        tr.axis(1).to_vec()
-    } else {
-        vec![0.0; tr.len()]
-    };
-    (tr.axis(0), y)
-}
-
 /// The sums of one training trajectory: every origin with `lags` legs behind it, every step
 /// inside the trajectory. The target is the future displacement minus the last velocity's
 /// extrapolation, both in the aligned frame. With `current` weights, each sample is weighed
@@ -235,11 +222,8 @@ fn accumulate(
             // (the model index depends on the step and on the last speed, frame.v0.0)
             let tau = t[o + s] - t[o];
             let d = (x[o + s] - x[o], y[o + s] - y[o]);
-            let (u0, u1) = frame.u;
-            let e = (
-                u0 * d.0 + u1 * d.1 - tau * frame.v0.0,
-                u0 * d.1 - u1 * d.0 - tau * frame.v0.1,
-            );
+            let r = frame.u.rotate(d);
+            let e = (r.0 - tau * frame.v0.0, r.1 - tau * frame.v0.1);
             frame.row(tau, &mut row);
             let m = params.model(frame.v0.0, s);
             let w = current.map_or(1.0, |c| {

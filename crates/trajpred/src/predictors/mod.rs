@@ -144,6 +144,43 @@ pub(crate) fn displaced_point(history: &Trajectory, (dx, dy): (f64, f64), tau: f
     p
 }
 
+/// The horizontal frame of the aligned methods (`aligned-ridge`, `aligned-gbm`): the unit
+/// heading `(cos, sin)` of the first velocity faster than 1e-9 m/s (+x if none).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Heading(f64, f64);
+
+impl Heading {
+    /// From velocities, newest first.
+    pub(crate) fn of<'a>(velocities: impl IntoIterator<Item = &'a (f64, f64)>) -> Self {
+        let (c, s) = velocities
+            .into_iter()
+            .map(|&(a, b)| (a, b, a.hypot(b)))
+            .find(|&(_, _, s)| s > 1e-9)
+            .map_or((1.0, 0.0), |(a, b, s)| (a / s, b / s));
+        Heading(c, s)
+    }
+
+    /// A vector in the frame where the heading points along +x.
+    pub(crate) fn rotate(self, (a, b): (f64, f64)) -> (f64, f64) {
+        (self.0 * a + self.1 * b, self.0 * b - self.1 * a)
+    }
+
+    /// An aligned vector back in the data's axes.
+    pub(crate) fn unrotate(self, (a, b): (f64, f64)) -> (f64, f64) {
+        (self.0 * a - self.1 * b, self.1 * a + self.0 * b)
+    }
+}
+
+/// The first two axes of a track (`y` zeros for a 1-D track).
+pub(crate) fn horizontal_axes(tr: &Trajectory) -> (&[f64], Vec<f64>) {
+    let y = if tr.dim() >= 2 {
+        tr.axis(1).to_vec()
+    } else {
+        vec![0.0; tr.len()]
+    };
+    (tr.axis(0), y)
+}
+
 /// Each trajectory its own group: what `fit` without groups means for the methods that
 /// cross-validate by group.
 pub(crate) fn own_groups(train: &[Trajectory]) -> Vec<usize> {
