@@ -7,8 +7,8 @@
 //! cargo run --release -p trajpred --example tune_by_user -- geolife ../shared/data/geolife 5 55
 //! ```
 //! (dataset, path, `--max-gap`, `--min-points`; a fifth argument `gbm` scores
-//! `aligned-gbm`'s variants instead, with a sixth `1` or `2` for the first or second
-//! round of them; the split is `--split by-user`,
+//! `aligned-gbm`'s variants instead, with a sixth `1` to `4` for the first to fourth round
+//! of them; the split is `--split by-user`,
 //! `--train-fraction 0.3`, `--seed 0`, the evaluation `--history 20 --horizon 5`.)
 
 use trajpred::dataset::{Dataset, Segmentation, load};
@@ -80,8 +80,47 @@ fn main() -> Result<()> {
                 Ok(Box::new(AlignedGbm::new(p.clone())?) as Box<dyn Predictor>)
             })
         };
-        let base = AlignedGbmParams::default;
-        if arg(6, "1") == "1" {
+        // rounds 1 and 2 ran before the shape features: they are scored without them
+        let base = || AlignedGbmParams {
+            shape_features: false,
+            robust_passes: 0,
+            ..Default::default()
+        };
+        // round 3 ran before the reweighted passes
+        let shape = || AlignedGbmParams {
+            robust_passes: 0,
+            ..Default::default()
+        };
+        if arg(6, "1") == "3" {
+            gbm("gbm without shape features", base())?;
+            gbm("gbm with shape features", shape())?;
+        } else if arg(6, "1") == "4" {
+            gbm(
+                "gbm 1 reweighted pass, floor 1 m",
+                AlignedGbmParams::default(),
+            )?;
+            gbm(
+                "gbm 2 reweighted passes",
+                AlignedGbmParams {
+                    robust_passes: 2,
+                    ..Default::default()
+                },
+            )?;
+            gbm(
+                "gbm 1 reweighted pass, floor 3 m",
+                AlignedGbmParams {
+                    robust_floor: 3.0,
+                    ..Default::default()
+                },
+            )?;
+            gbm(
+                "gbm 1 reweighted pass, no shape features",
+                AlignedGbmParams {
+                    shape_features: false,
+                    ..Default::default()
+                },
+            )?;
+        } else if arg(6, "1") == "1" {
             gbm(
                 "gbm 100 rounds",
                 AlignedGbmParams {

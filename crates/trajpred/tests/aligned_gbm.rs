@@ -139,6 +139,13 @@ fn bad_parameters_and_misuse_are_typed_errors() {
         },
         "max_samples",
     );
+    bad(
+        AlignedGbmParams {
+            robust_floor: 0.0,
+            ..params()
+        },
+        "robust_floor",
+    );
 
     let tr = braking(1);
     let h = tr.prefix(21).expect("prefix");
@@ -184,6 +191,15 @@ fn bad_parameters_and_misuse_are_typed_errors() {
         other.load_fitted_params(&saved),
         Err(Error::InvalidFitted { path, .. }) if path == "lags"
     ));
+    let mut plain = AlignedGbm::new(AlignedGbmParams {
+        shape_features: false,
+        ..params()
+    })
+    .expect("valid");
+    assert!(matches!(
+        plain.load_fitted_params(&saved),
+        Err(Error::InvalidFitted { path, .. }) if path == "shape_features"
+    ));
     let mut broken = saved.clone();
     broken["models"] = serde_json::json!([1, 2]);
     let mut same = AlignedGbm::new(params()).expect("valid");
@@ -196,4 +212,44 @@ fn bad_parameters_and_misuse_are_typed_errors() {
         same.forecast(&h, 5).expect("forecast"),
         m.forecast(&h, 5).expect("forecast")
     );
+}
+
+/// Straight tracks of 10 points at 10 m/s along x on a 1 s grid (one origin with 8 legs
+/// behind it, at index 8); in every fourth the last fix is 50 m ahead of where it should be
+/// (a jump the history cannot foretell: the same history leads to both outcomes).
+fn straight_with_jumps(k: usize) -> Trajectory {
+    let n = 10;
+    let t: Vec<f64> = (0..n).map(|i| i as f64).collect();
+    let x = t
+        .iter()
+        .enumerate()
+        .map(|(i, &t)| 10.0 * t + if k.is_multiple_of(4) && i == 9 { 50.0 } else { 0.0 })
+        .collect();
+    Trajectory::from_axes(t, vec![x, vec![0.0; n]]).expect("finite, increasing")
+}
+
+#[test]
+fn reweighted_passes_move_the_fit_from_the_mean_to_the_median() {
+    // one step ahead: a quarter of the targets jump 50 m, so least squares predicts
+    // 12.5 m ahead of the straight line, the median (what the mean distance wants) on it;
+    // by hand, Weiszfeld's passes give 5.0, 1.79 and 0.61 m
+    let train: Vec<Trajectory> = (0..40).map(straight_with_jumps).collect();
+    let fit = |robust_passes: usize| {
+        let mut m = AlignedGbm::new(AlignedGbmParams {
+            horizons: 1,
+            iterations: 50,
+            min_leaf_samples: 1.0,
+            clip_quantile: 1.0,
+            robust_passes,
+            ..Default::default()
+        })
+        .expect("valid");
+        m.fit(&train).expect("fits");
+        let h = straight_with_jumps(1).prefix(9).expect("prefix");
+        m.forecast_times(&h, &[9.0]).expect("forecast").step(1)[0] - 90.0
+    };
+    let (mean, once, thrice) = (fit(0), fit(1), fit(3));
+    assert!((mean - 12.5).abs() < 0.5, "least squares: {mean} m ahead");
+    assert!(once < 10.0, "one reweighted pass: {once} m ahead");
+    assert!(thrice < 0.5 * once, "three passes: {thrice} m ahead");
 }

@@ -129,6 +129,13 @@ impl<'a> At<'a> {
             .ok_or_else(|| self.error("expected a string"))
     }
 
+    /// A boolean.
+    pub(crate) fn bool(&self) -> Result<bool> {
+        self.value
+            .as_bool()
+            .ok_or_else(|| self.error("expected true or false"))
+    }
+
     /// A finite number (an exact string or a JSON number).
     pub(crate) fn f64(&self) -> Result<f64> {
         let v = match self.value {
