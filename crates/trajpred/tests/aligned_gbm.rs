@@ -223,7 +223,14 @@ fn straight_with_jumps(k: usize) -> Trajectory {
     let x = t
         .iter()
         .enumerate()
-        .map(|(i, &t)| 10.0 * t + if k.is_multiple_of(4) && i == 9 { 50.0 } else { 0.0 })
+        .map(|(i, &t)| {
+            10.0 * t
+                + if k.is_multiple_of(4) && i == 9 {
+                    50.0
+                } else {
+                    0.0
+                }
+        })
         .collect();
     Trajectory::from_axes(t, vec![x, vec![0.0; n]]).expect("finite, increasing")
 }
