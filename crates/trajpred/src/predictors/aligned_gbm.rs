@@ -579,8 +579,8 @@ impl Predictor for AlignedGbm {
         self.params.lags + 1
     }
 
-    /// `{"lags", "window", "horizons", "shape_features"}` (checked against this predictor's parameters on
-    /// loading) and `"models"`: per step, the along- and across-track tree ensembles
+    /// `{"lags", "window", "horizons", "shape_features"}` (checked against this predictor's
+    /// parameters on loading) and `"models"`: per step, the along- and across-track tree ensembles
     /// (`{"base", "trees"}`, each tree node by node).
     fn fitted_params(&self) -> Result<serde_json::Value> {
         if self.models.is_empty() {
@@ -664,7 +664,41 @@ impl Predictor for AlignedGbm {
 
 #[cfg(test)]
 mod tests {
-    use super::poly_fit;
+    use super::{AlignedGbmParams, Origin, poly_fit};
+
+    #[test]
+    fn every_feature_is_the_same_for_a_turned_and_moved_history() {
+        // the features are taken in the frame of the last velocity: turning and moving the
+        // window must leave every one of them as it was
+        let t: Vec<f64> = (0..25)
+            .map(|i| i as f64 * 1.5 + 0.4 * ((i * 5) % 3) as f64)
+            .collect();
+        let x: Vec<f64> = t.iter().map(|t| 8.0 * t - 0.05 * t * t).collect();
+        let y: Vec<f64> = t.iter().map(|t| 3.0 * (0.2 * t).sin() * t).collect();
+        let (c, s) = (0.7_f64.cos(), 0.7_f64.sin());
+        let tx: Vec<f64> = x
+            .iter()
+            .zip(&y)
+            .map(|(a, b)| c * a - s * b + 300.0)
+            .collect();
+        let ty: Vec<f64> = x
+            .iter()
+            .zip(&y)
+            .map(|(a, b)| s * a + c * b - 120.0)
+            .collect();
+        let p = AlignedGbmParams::default();
+        let (a, b) = (
+            Origin::new(&p, &t, &x, &y, 24),
+            Origin::new(&p, &t, &tx, &ty, 24),
+        );
+        assert_eq!(a.feats.len(), p.features());
+        for (i, (u, v)) in a.feats.iter().zip(&b.feats).enumerate() {
+            assert!(
+                (u - v).abs() < 1e-9 * (1.0 + u.abs()),
+                "feature {i}: {u} against {v}"
+            );
+        }
+    }
 
     #[test]
     fn poly_fit_recovers_a_parabola_and_a_line_at_the_last_time() {
