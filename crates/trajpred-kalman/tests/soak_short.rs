@@ -1,11 +1,11 @@
-//! A short version of the soak (`examples/soak.rs`, included here): 1.2 x 10^5 filter steps of the
+//! A short version of the soak (`examples/kalman_soak.rs`, included here): 1.2 x 10^5 filter steps of the
 //! KF, the UKF (range-bearing and position observations), the filter driver over
 //! irregular times and the IMM (constant velocity + coordinated turn), every 100 steps checking the covariance finite, symmetric and positive
 //! semi-definite (tolerances `SYM_TOL`, `PSD_TOL` of the example) and the log-likelihood
 //! finite.
 
 #[allow(dead_code)]
-#[path = "../examples/soak.rs"]
+#[path = "../examples/kalman_soak.rs"]
 mod soak;
 
 use nalgebra::{DMatrix, Matrix3};

@@ -2,16 +2,16 @@
 //! constant velocity, position observations (10 % missing), 500 particles, residual
 //! resampling every step. Every `check_every` steps the weighted covariance of the estimate
 //! must be finite, symmetric and positive semi-definite (the Kalman soak's check,
-//! `trajpred-kalman/examples/soak.rs`, included here); every step's log-likelihood finite and
+//! `trajpred-kalman/examples/kalman_soak.rs`, included here); every step's log-likelihood finite and
 //! its effective sample size in `[1, n]`. VmRSS is read at the start, after the first track
 //! and at the end.
 //!
 //! ```text
-//! cargo run --release -p trajpred-particle --example soak -- <steps> <seed>
+//! cargo run --release -p trajpred-particle --example particle_soak -- <steps> <seed>
 //! ```
 
 #[allow(dead_code)]
-#[path = "../../trajpred-kalman/examples/soak.rs"]
+#[path = "../../trajpred-kalman/examples/kalman_soak.rs"]
 mod kalman_soak;
 
 use kalman_soak::{Part, check_cov, vm_rss_kib};

@@ -15,7 +15,7 @@
 //! track and at the end.
 //!
 //! ```text
-//! cargo run --release -p trajpred-kalman --example soak -- <total steps> <seed>
+//! cargo run --release -p trajpred-kalman --example kalman_soak -- <total steps> <seed>
 //! ```
 //!
 //! The steps are split 30 % KF, 25 % UKF, 25 % driver, 20 % IMM, in tracks of up to 10^6
