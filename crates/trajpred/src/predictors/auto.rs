@@ -97,6 +97,32 @@ pub(crate) fn fold_of_trajectories(
     Ok((fold, k))
 }
 
+/// The checks `auto` and `blend` share at construction: at least one candidate, at least 2
+/// folds, valid evaluation settings, and every candidate known to the registry (built with
+/// `options`) and not refused by `refuse` (which returns the reason).
+pub(crate) fn check_selection(
+    candidates: &[String],
+    folds: usize,
+    eval: &EvalConfig,
+    options: &MethodOptions,
+    refuse: impl Fn(&str) -> Option<String>,
+) -> Result<()> {
+    if candidates.is_empty() {
+        return Err(invalid("candidates", "needs at least one method, got none"));
+    }
+    if folds < 2 {
+        return Err(invalid("folds", format!("must be at least 2, got {folds}")));
+    }
+    eval.validate()?;
+    for c in candidates {
+        if let Some(why) = refuse(c) {
+            return Err(invalid("candidates", why));
+        }
+        registry::build(c, options)?;
+    }
+    Ok(())
+}
+
 /// The training trajectories (and their groups) outside fold `f`, and those inside it.
 pub(crate) fn fold_split(
     train: &[Trajectory],
@@ -173,28 +199,20 @@ impl Auto {
     /// no candidate, a candidate the registry does not know, `auto` among them, fewer than
     /// 2 folds or bad evaluation settings.
     pub fn new(params: AutoParams, options: MethodOptions) -> Result<Self> {
-        if params.candidates.is_empty() {
-            return Err(invalid("candidates", "needs at least one method, got none"));
-        }
-        if params.folds < 2 {
-            return Err(invalid(
-                "folds",
-                format!("must be at least 2, got {}", params.folds),
-            ));
-        }
-        params.eval.validate()?;
-        for c in &params.candidates {
-            if c == "auto" {
-                return Err(invalid(
-                    "candidates",
+        check_selection(
+            &params.candidates,
+            params.folds,
+            &params.eval,
+            &options,
+            |c| {
+                (c == "auto").then(|| {
                     format!(
                         "`auto` cannot choose among itself, got {:?}",
                         params.candidates
-                    ),
-                ));
-            }
-            registry::build(c, &options)?;
-        }
+                    )
+                })
+            },
+        )?;
         Ok(Auto {
             params,
             options,

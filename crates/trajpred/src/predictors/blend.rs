@@ -1,7 +1,9 @@
 //! `blend`: a weighted mean of several methods' forecasts, the weights of each forecast step
 //! chosen by greedy ensemble selection on forecasts held out by group (issue 27).
 
-use super::auto::{DEFAULT_CANDIDATES, fold_of_trajectories, fold_split, load_member};
+use super::auto::{
+    DEFAULT_CANDIDATES, check_selection, fold_of_trajectories, fold_split, load_member,
+};
 use super::fitted::{At, exact_vec};
 use super::invalid;
 use held_out::{HeldOut, quantile_edges, regime_of, speed_at};
@@ -130,33 +132,25 @@ impl Blend {
     /// candidate, an unknown one, `blend` or `auto` among them, fewer than 2 folds, no
     /// round or bad evaluation settings.
     pub fn new(params: BlendParams, options: MethodOptions) -> Result<Self> {
-        if params.candidates.is_empty() {
-            return Err(invalid("candidates", "needs at least one method, got none"));
-        }
-        if params.folds < 2 {
-            return Err(invalid(
-                "folds",
-                format!("must be at least 2, got {}", params.folds),
-            ));
-        }
+        check_selection(
+            &params.candidates,
+            params.folds,
+            &params.eval,
+            &options,
+            |c| {
+                (c == "blend" || c == "auto").then(|| {
+                    format!(
+                        "`{c}` chooses among methods itself and cannot be blended, got {:?}",
+                        params.candidates
+                    )
+                })
+            },
+        )?;
         if params.rounds == 0 {
             return Err(invalid("rounds", "must be at least 1, got 0"));
         }
         if params.max_regimes == 0 {
             return Err(invalid("max_regimes", "must be at least 1, got 0"));
-        }
-        params.eval.validate()?;
-        for c in &params.candidates {
-            if c == "blend" || c == "auto" {
-                return Err(invalid(
-                    "candidates",
-                    format!(
-                        "`{c}` chooses among methods itself and cannot be blended, got {:?}",
-                        params.candidates
-                    ),
-                ));
-            }
-            registry::build(c, &options)?;
         }
         Ok(Blend {
             params,
