@@ -117,10 +117,50 @@ fn auto_refuses_bad_settings_and_forecasts_only_once_fitted() {
         ..Default::default()
     };
     assert!(Auto::new(p, options()).is_err());
-    // one group cannot be cross-validated by group
+    // one trajectory cannot be cross-validated; groups must match the trajectories
     let mut a = auto_over(CANDIDATES);
-    assert!(a.fit_grouped(&[tr.clone(), tr.clone()], &[3, 3]).is_err());
+    assert!(matches!(
+        a.fit_grouped(std::slice::from_ref(&tr), &[3]),
+        Err(trajpred_core::Error::InvalidParameter { name, .. }) if name == "train"
+    ));
     assert!(a.fit_grouped(&[tr], &[0, 1]).is_err());
+}
+
+#[test]
+fn one_training_group_is_cross_validated_by_trajectory_and_says_so() {
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let train: Vec<Trajectory> = (0..6).map(|_| straight(&mut rng)).collect();
+    // one user: the folds deal the trajectories themselves (before: an error)
+    let mut auto = auto_over(CANDIDATES);
+    auto.fit_grouped(&train, &[7; 6]).unwrap();
+    assert_eq!(auto.chosen(), Some("cv-time"));
+    assert!(auto.scores().iter().all(|s| s.fold_errors.len() == 5));
+    let summary = auto.fitted_summary().unwrap();
+    assert!(
+        summary.starts_with(
+            "chose cv-time by 5-fold cross-validation by trajectory (one training group)"
+        ),
+        "{summary}"
+    );
+    // several users: by group, as before
+    let mut auto = auto_over(CANDIDATES);
+    auto.fit_grouped(&train, &[0, 0, 1, 1, 2, 2]).unwrap();
+    let summary = auto.fitted_summary().unwrap();
+    assert!(
+        summary.starts_with("chose cv-time by 3-fold cross-validation by group"),
+        "{summary}"
+    );
+    // a candidate that cross-validates inside each of auto's folds (aligned-ridge), with two
+    // users: each fold trains on one user, which it now folds by trajectory instead of failing
+    let mut two = Vec::new();
+    for _ in 0..8 {
+        two.push(straight(&mut rng));
+    }
+    let mut auto = auto_over(&["cv-time", "aligned-ridge"]);
+    auto.fit_grouped(&two, &[0, 0, 0, 0, 1, 1, 1, 1]).unwrap();
+    for s in auto.scores() {
+        assert!(s.failure.is_none(), "{}: {:?}", s.method, s.failure);
+    }
 }
 
 fn custom_protocol(methods: &[&str]) -> Protocol {

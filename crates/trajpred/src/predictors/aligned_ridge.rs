@@ -1,7 +1,7 @@
 //! `aligned-ridge`: a linear correction of the last velocity, learned in a heading-aligned,
 //! time-normalised frame (issue 27, idea b).
 
-use super::auto::{fold_of_trajectories, fold_split};
+use super::auto::{cv_unit, fold_of_trajectories, fold_split};
 use super::fitted::{At, exact, exact_matrix, exact_vec};
 use super::{Heading, horizontal_axes as xy, invalid};
 use crate::harness::{self, EvalConfig};
@@ -314,6 +314,13 @@ pub struct AlignedRidge {
     weights: Vec<DMatrix<f64>>,
     /// The strength used and, if chosen by CV, each strength's pooled held-out error.
     chosen: Option<(f64, Vec<(f64, f64)>)>,
+    /// What the cross-validation's folds were dealt by ([`cv_unit`]).
+    #[serde(skip, default = "by_group")]
+    cv_unit: &'static str,
+}
+
+fn by_group() -> &'static str {
+    "group"
 }
 
 impl AlignedRidge {
@@ -324,6 +331,7 @@ impl AlignedRidge {
             params,
             weights: Vec::new(),
             chosen: None,
+            cv_unit: by_group(),
         })
     }
 
@@ -425,6 +433,7 @@ impl Predictor for AlignedRidge {
             Some(l) => (l, Vec::new()),
             None => {
                 let scores = self.cross_validate(train, groups)?;
+                self.cv_unit = cv_unit(groups);
                 let best = scores
                     .iter()
                     .filter(|(_, e)| e.is_finite())
@@ -555,7 +564,8 @@ impl Predictor for AlignedRidge {
                 .map(|(l, e)| format!("{l:e}: {e:.3} m"))
                 .collect();
             s.push_str(&format!(
-                " (chosen by cross-validation by group; held-out mean error {})",
+                " (chosen by cross-validation by {}; held-out mean error {})",
+                self.cv_unit,
                 cv.join(", ")
             ));
         }

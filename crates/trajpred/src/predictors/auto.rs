@@ -70,7 +70,9 @@ pub struct CandidateScore {
 
 /// The folds of a grouped training set: `fold[i]` is the fold of trajectory `i`, dealt by
 /// group ([`harness::group_folds`]); the second value is the number of folds used,
-/// `min(folds, groups)`. Needs at least two groups.
+/// `min(folds, groups)`. With a single group (one training user, say, or one inside a fold
+/// of an outer cross-validation) the trajectories are dealt one by one instead
+/// ([`cv_unit`] names which); needs at least two trajectories then.
 pub(crate) fn fold_of_trajectories(
     groups: &[usize],
     folds: usize,
@@ -80,11 +82,14 @@ pub(crate) fn fold_of_trajectories(
     labels.sort_unstable();
     labels.dedup();
     if labels.len() < 2 {
+        if groups.len() >= 2 {
+            return fold_of_trajectories(&super::own_groups_of(groups.len()), folds, seed);
+        }
         return Err(invalid(
             "train",
             format!(
-                "cross-validation by group needs trajectories of at least 2 groups, got {}",
-                labels.len()
+                "cross-validation needs at least 2 training trajectories, got {}",
+                groups.len()
             ),
         ));
     }
@@ -95,6 +100,16 @@ pub(crate) fn fold_of_trajectories(
         .map(|g| labels.binary_search(g).map_or(0, |i| of_label[i]))
         .collect();
     Ok((fold, k))
+}
+
+/// What [`fold_of_trajectories`] deals into folds for these groups, for summaries: `"group"`,
+/// or `"trajectory (one training group)"`.
+pub(crate) fn cv_unit(groups: &[usize]) -> &'static str {
+    if groups.iter().any(|&g| g != groups[0]) {
+        "group"
+    } else {
+        "trajectory (one training group)"
+    }
 }
 
 /// The checks `auto` and `blend` share at construction: at least one candidate, at least 2
@@ -182,6 +197,8 @@ pub struct Auto {
     chosen: Option<(String, Box<dyn Predictor>)>,
     scores: Vec<CandidateScore>,
     folds_used: usize,
+    /// What the folds were dealt by ([`cv_unit`]).
+    cv_unit: &'static str,
 }
 
 impl std::fmt::Debug for Auto {
@@ -219,6 +236,7 @@ impl Auto {
             chosen: None,
             scores: Vec::new(),
             folds_used: 0,
+            cv_unit: "group",
         })
     }
 
@@ -307,6 +325,7 @@ impl Predictor for Auto {
         super::check_groups(train, groups)?;
         self.chosen = None;
         self.folds_used = fold_of_trajectories(groups, self.params.folds, self.params.seed)?.1;
+        self.cv_unit = cv_unit(groups);
         let scores = self
             .params
             .candidates
@@ -385,8 +404,8 @@ impl Predictor for Auto {
             return Some(format!("{chosen}, loaded from saved parameters"));
         }
         let mut s = format!(
-            "chose {chosen} by {}-fold cross-validation by group (mean error, m, per fold):",
-            self.folds_used
+            "chose {chosen} by {}-fold cross-validation by {} (mean error, m, per fold):",
+            self.folds_used, self.cv_unit
         );
         for c in &self.scores {
             match &c.failure {

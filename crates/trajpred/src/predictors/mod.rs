@@ -187,6 +187,11 @@ pub(crate) fn own_groups(train: &[Trajectory]) -> Vec<usize> {
     (0..train.len()).collect()
 }
 
+/// Labels `0..n`: `n` trajectories, each its own group.
+pub(crate) fn own_groups_of(n: usize) -> Vec<usize> {
+    (0..n).collect()
+}
+
 /// One group label per training trajectory.
 pub(crate) fn check_groups(train: &[Trajectory], groups: &[usize]) -> Result<()> {
     if groups.len() == train.len() {
