@@ -482,10 +482,17 @@ pub fn split_segments(segments: &[Segment], how: Split) -> Result<(Vec<Segment>,
             groups.dedup();
             groups.shuffle(&mut rand_chacha::ChaCha8Rng::seed_from_u64(seed));
             let n = groups.len();
-            let mut cut = (n as f64 * train_fraction).round() as usize;
-            if n >= 2 {
-                cut = cut.clamp(1, n - 1);
+            if n < 2 {
+                return Err(Error::InvalidParameter {
+                    name: "split",
+                    reason: format!(
+                        "a split by group (user, vehicle) needs segments of at least 2 groups, \
+                         got {n}{}",
+                        groups.first().map_or(String::new(), |g| format!(" ({g})"))
+                    ),
+                });
             }
+            let cut = ((n as f64 * train_fraction).round() as usize).clamp(1, n - 1);
             let train_groups: std::collections::HashSet<&str> =
                 groups[..cut].iter().copied().collect();
             let (train, test): (Vec<Segment>, Vec<Segment>) = segments

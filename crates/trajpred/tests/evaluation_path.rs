@@ -166,6 +166,20 @@ fn split_by_user_keeps_every_user_on_one_side() {
     )
     .expect("split");
     assert!(users(&t1).iter().any(|u| users(&t2).contains(u)));
+    // one user's segments cannot be split by user: a typed error naming the split and the
+    // user (before: an empty training part, reported only when a method was fitted)
+    let one: Vec<Segment> = segments
+        .iter()
+        .filter(|s| s.group == "user3")
+        .cloned()
+        .collect();
+    match split_segments(&one, how) {
+        Err(trajpred_core::Error::InvalidParameter { name, reason }) => {
+            assert_eq!(name, "split");
+            assert!(reason.contains("got 1 (user3)"), "{reason}");
+        }
+        other => panic!("expected InvalidParameter split, got {other:?}"),
+    }
 }
 
 /// A CSV folder: two files, each with an `id` column holding two walkers, epoch-millisecond
