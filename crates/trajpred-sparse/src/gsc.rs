@@ -35,6 +35,8 @@ pub struct GscParams {
     horizons: usize,
     lars: LarsParams,
     parallel: bool,
+    #[serde(default)]
+    relative: bool,
 }
 
 impl GscParams {
@@ -45,6 +47,14 @@ impl GscParams {
         /// Fit the horizons in parallel with rayon when the problem is large enough to pay
         /// (default `true`); `false` always fits them one after another.
         parallel(yes: bool) => self.parallel = yes;
+        /// Work in the frame of each window's last value (default `false`: the paper's
+        /// absolute values): every design row and its target have the row's last value
+        /// subtracted, and a prediction adds the window's last value back, so that
+        /// `predict(w + c) = predict(w) + c` for any shift `c`. In absolute values that holds
+        /// only when every row of `A` sums to 1, which a LAR path stopped early does not
+        /// give: series far from the training ones' level are then forecast with a bias
+        /// (see `docs/gskf.md`). The last column of `A` stays 0 in this frame.
+        relative(yes: bool) => self.relative = yes;
     }
 
     /// Fits the `T` horizon models on `series` (oldest first).
@@ -163,6 +173,17 @@ impl GscParams {
             }
             HankelDesign { design, target }
         };
+        let mut d = d;
+        if self.relative {
+            let m = self.window;
+            for r in 0..d.target.len() {
+                let last = d.design[(r, m - 1)];
+                for k in 0..m {
+                    d.design[(r, k)] -= last;
+                }
+                d.target[r] -= last;
+            }
+        }
         let y = d.target.as_slice();
         let rows = y.len() as f64;
         let (coef, intercept, path) = match self.lars.fit(&d.design, y) {
@@ -220,6 +241,7 @@ impl GroupSparseCoder {
             horizons,
             lars: Lars::params(),
             parallel: true,
+            relative: false,
         }
     }
 
@@ -306,6 +328,20 @@ impl GroupSparseCoder {
         })
     }
 
+    /// Whether the coder works in the frame of each window's last value
+    /// ([`GscParams::relative`]).
+    pub fn is_relative(&self) -> bool {
+        self.params.relative
+    }
+
+    /// The same coefficients read in the frame of each window's last value (`true`) or in
+    /// absolute values: for a coder rebuilt with [`from_parts`](Self::from_parts) from one
+    /// fitted with [`GscParams::relative`].
+    pub fn in_relative_frame(mut self, yes: bool) -> Self {
+        self.params.relative = yes;
+        self
+    }
+
     /// Window length m.
     pub fn window(&self) -> usize {
         self.params.window
@@ -360,15 +396,21 @@ impl GroupSparseCoder {
             }
             .into());
         }
+        let origin = if self.params.relative {
+            window[m - 1]
+        } else {
+            0.0
+        };
         Ok((0..self.horizons())
             .map(|t| {
-                self.b[t]
+                origin
+                    + self.b[t]
                     + self
                         .a
                         .row(t)
                         .iter()
                         .zip(window)
-                        .map(|(a, w)| a * w)
+                        .map(|(a, w)| a * (w - origin))
                         .sum::<f64>()
             })
             .collect())

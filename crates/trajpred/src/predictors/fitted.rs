@@ -56,11 +56,24 @@ impl<'a> At<'a> {
 
     /// The object's fields, refusing any field not in `keys` and any of them missing.
     pub(crate) fn fields<const N: usize>(&self, keys: [&str; N]) -> Result<[At<'a>; N]> {
+        self.fields_and(keys, &[])
+    }
+
+    /// As [`fields`](Self::fields), also allowing the fields `optional` (not returned: read
+    /// them with [`value`](Self::value)).
+    pub(crate) fn fields_and<const N: usize>(
+        &self,
+        keys: [&str; N],
+        optional: &[&str],
+    ) -> Result<[At<'a>; N]> {
         let obj = self
             .value
             .as_object()
             .ok_or_else(|| self.error(format!("expected an object with {keys:?}")))?;
-        if let Some(k) = obj.keys().find(|k| !keys.contains(&k.as_str())) {
+        if let Some(k) = obj
+            .keys()
+            .find(|k| !keys.contains(&k.as_str()) && !optional.contains(&k.as_str()))
+        {
             return Err(self.error(format!("unknown field `{k}`; expected {keys:?}")));
         }
         let mut out = Vec::with_capacity(N);

@@ -42,6 +42,13 @@ pub struct GskfParams {
     /// paths where held-out groups say (the full path or 1 to m - 1 steps, by 5-fold
     /// cross-validation by group; see `docs/gskf.md`). One group, or `false`: the full path.
     pub choose_steps: bool,
+    /// Fit and forecast each axis in the frame of each window's last value
+    /// ([`trajpred_sparse::GscParams::relative`]; default `false`, the paper's absolute
+    /// values). The frame makes a forecast move with the track (a shifted history gives a
+    /// shifted forecast), which absolute values give only where each row of `A` sums to 1;
+    /// see `docs/gskf.md`. Saved with the fitted parameters and checked on loading.
+    #[serde(default)]
+    pub relative: bool,
 }
 
 impl Default for GskfParams {
@@ -52,6 +59,7 @@ impl Default for GskfParams {
             q: None,
             q_grid: vec![1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0],
             choose_steps: true,
+            relative: false,
         }
     }
 }
@@ -111,7 +119,8 @@ fn fit_gsc(
     series: &[&[f64]],
     steps: Option<usize>,
 ) -> Result<GroupSparseCoder> {
-    let mut gsc = GroupSparseCoder::params(params.window, params.horizons);
+    let mut gsc =
+        GroupSparseCoder::params(params.window, params.horizons).relative(params.relative);
     if let Some(s) = steps {
         gsc = gsc.lars(Lars::params().max_steps(s));
     }
@@ -289,7 +298,42 @@ fn coder_json(gsc: &GroupSparseCoder) -> serde_json::Map<String, serde_json::Val
         "residual_variances".into(),
         exact_vec(gsc.residual_variances()),
     );
+    if gsc.is_relative() {
+        // (only then: files saved before the frame existed stay valid)
+        m.insert("relative".into(), true.into());
+    }
     m
+}
+
+/// The fields `keys` of a saved axis, allowing a `"relative": true` beside them, which must
+/// agree with `params.relative` (a coder read in the wrong frame would forecast wrongly).
+fn axis_fields<'a, const N: usize>(
+    params: &GskfParams,
+    ax: &At<'a>,
+    keys: [&str; N],
+) -> Result<[At<'a>; N]> {
+    let saved = match ax.value().get("relative") {
+        None => false,
+        Some(v) => v
+            .as_bool()
+            .ok_or_else(|| ax.error("`relative`: expected true or false"))?,
+    };
+    if saved != params.relative {
+        let frame = |rel: bool| {
+            if rel {
+                "the frame of each window's last value"
+            } else {
+                "absolute values"
+            }
+        };
+        return Err(ax.error(format!(
+            "fitted in {}, but this method is set to {} (`relative` = {})",
+            frame(saved),
+            frame(params.relative),
+            params.relative
+        )));
+    }
+    ax.fields_and(keys, &["relative"])
 }
 
 /// Reads a coder back from its fields `a`, `b`, `residual_variances`, with the shape the
@@ -300,6 +344,7 @@ fn coder_from(params: &GskfParams, a: &At, b: &At, rv: &At) -> Result<GroupSpars
     let b_v = b.vector(t, At::f64)?;
     let rv_v = rv.vector(t, |x| x.f64_min(0.0, false))?;
     GroupSparseCoder::from_parts(a_m, b_v, rv_v.as_slice().to_vec())
+        .map(|g| g.in_relative_frame(params.relative))
         .map_err(|e| a.error(e.to_string()))
 }
 
@@ -490,7 +535,7 @@ impl Predictor for Gsc {
         let axes = axes_of("gsc", params)?
             .iter()
             .map(|ax| {
-                let [a, b, rv] = ax.fields(["a", "b", "residual_variances"])?;
+                let [a, b, rv] = axis_fields(&self.params, ax, ["a", "b", "residual_variances"])?;
                 coder_from(&self.params, &a, &b, &rv)
             })
             .collect::<Result<_>>()?;
@@ -680,8 +725,11 @@ impl Predictor for Gskf {
         let axes = axes_of("gskf", params)?
             .iter()
             .map(|ax| {
-                let [a, b, rv, q, correct] =
-                    ax.fields(["a", "b", "residual_variances", "q", "correct"])?;
+                let [a, b, rv, q, correct] = axis_fields(
+                    &self.params,
+                    ax,
+                    ["a", "b", "residual_variances", "q", "correct"],
+                )?;
                 let gsc = coder_from(&self.params, &a, &b, &rv)?;
                 let on = correct
                     .value()
