@@ -1,23 +1,19 @@
 //! `gsc` and `gskf` with `GskfParams::relative`: a history moved by a constant is forecast
 //! moved by the same constant, and the frame travels with the saved parameters.
 
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use trajpred::predictors::{Gsc, Gskf, GskfParams};
 use trajpred_core::{Error, Predictor, Trajectory};
 
-/// A 2-D track wandering about the origin (two damped oscillations with a seeded LCG's
+/// A 2-D track wandering about the origin (two damped oscillations driven by seeded uniform
 /// noise), 300 points 1 s apart.
 fn wander(seed: u64) -> Trajectory {
-    let mut state = seed;
-    let mut noise = move || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-    };
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let (mut x, mut y) = (vec![0.0, 1.0], vec![0.0, -1.0]);
     for i in 2..300 {
-        x.push(1.5 * x[i - 1] - 0.6 * x[i - 2] + 2.0 * noise());
-        y.push(1.4 * y[i - 1] - 0.5 * y[i - 2] + 2.0 * noise());
+        x.push(1.5 * x[i - 1] - 0.6 * x[i - 2] + rng.random_range(-1.0..1.0));
+        y.push(1.4 * y[i - 1] - 0.5 * y[i - 2] + rng.random_range(-1.0..1.0));
     }
     Trajectory::uniform(0.0, 1.0, vec![x, y]).unwrap()
 }
