@@ -107,3 +107,77 @@ fn the_frame_is_saved_and_a_mismatch_on_loading_is_refused() {
         plain.forecast(&history, 6).unwrap()
     );
 }
+
+#[test]
+fn with_choose_frame_held_out_groups_at_other_places_choose_the_relative_frame() {
+    // five groups (users), each wandering about its own place 2 km from the next: fitted in
+    // absolute values on four of them, the coder pulls a held-out group's forecast towards
+    // the others' places, so the folds choose the relative frame on both axes
+    let mut train = Vec::new();
+    let mut groups = Vec::new();
+    for g in 0..5 {
+        for i in 0..2 {
+            let offset = 2_000.0 * g as f64;
+            train.push(moved(&wander(10 * g + i), [offset, -offset]));
+            groups.push(g as usize);
+        }
+    }
+    let choose = GskfParams {
+        choose_frame: true,
+        ..Default::default()
+    };
+    for p in [
+        Box::new(Gsc::new(choose.clone()).unwrap()) as Box<dyn Predictor>,
+        Box::new(Gskf::new(choose.clone()).unwrap()),
+    ] {
+        let mut p = p;
+        p.fit_grouped(&train, &groups).unwrap();
+        let said = p.fitted_summary().unwrap();
+        assert!(
+            said.contains("frame and LAR steps chosen per axis"),
+            "{said}"
+        );
+        assert_eq!(said.matches("-> relative").count(), 2, "{said}");
+        // a user somewhere else is forecast as it would be at the origin, moved
+        let history = wander(99).prefix(100).unwrap();
+        let c = [7_000.0, 3_000.0];
+        let (near, far) = (
+            p.forecast(&history, 3).unwrap(),
+            p.forecast(&moved(&history, c), 3).unwrap(),
+        );
+        for k in 1..=3 {
+            for (d, cd) in c.iter().enumerate() {
+                assert!((far.step(k)[d] - near.step(k)[d] - cd).abs() < 1e-6);
+            }
+        }
+        // the frames travel with the parameters: a predictor that may choose reads them back
+        let saved = p.fitted_params().unwrap();
+        assert_eq!(saved["axes"][1]["relative"], serde_json::json!(true));
+        let mut back: Box<dyn Predictor> = if p.name() == "gsc" {
+            Box::new(Gsc::new(choose.clone()).unwrap())
+        } else {
+            Box::new(Gskf::new(choose.clone()).unwrap())
+        };
+        back.load_fitted_params(&saved).unwrap();
+        assert_eq!(
+            back.forecast(&history, 3).unwrap(),
+            p.forecast(&history, 3).unwrap()
+        );
+        // one set to absolute values without the choice refuses them
+        let mut fixed = Gsc::new(params(false)).unwrap();
+        if p.name() == "gsc" {
+            assert!(matches!(
+                fixed.load_fitted_params(&saved),
+                Err(Error::InvalidFitted { .. })
+            ));
+        }
+    }
+    // without the choice (the default) the same data keep absolute values
+    let mut plain = Gsc::new(GskfParams::default()).unwrap();
+    plain.fit_grouped(&train, &groups).unwrap();
+    let said = plain.fitted_summary().unwrap();
+    assert!(
+        said.starts_with("LAR steps chosen") && !said.contains("relative"),
+        "{said}"
+    );
+}

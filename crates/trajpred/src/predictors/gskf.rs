@@ -49,6 +49,12 @@ pub struct GskfParams {
     /// see `docs/gskf.md`. Saved with the fitted parameters and checked on loading.
     #[serde(default)]
     pub relative: bool,
+    /// With `choose_steps` and trajectories of several groups, each axis also chooses its
+    /// frame, absolute values or the frame of each window's last value, on the same held-out
+    /// groups as its LAR steps (ties go to absolute values, the paper's); `relative` is then
+    /// only the frame of a fit without groups. Default `false` (see `docs/gskf.md`).
+    #[serde(default)]
+    pub choose_frame: bool,
 }
 
 impl Default for GskfParams {
@@ -60,6 +66,7 @@ impl Default for GskfParams {
             q_grid: vec![1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0],
             choose_steps: true,
             relative: false,
+            choose_frame: false,
         }
     }
 }
@@ -112,16 +119,15 @@ fn axis_series(train: &[Trajectory], axis: usize, needed: usize) -> Vec<&[f64]> 
         .collect()
 }
 
-/// The GSC of one axis; `steps` stops every horizon's LAR path after that many steps
-/// (`None`: the full path, whose end is least squares).
+/// The GSC of one axis in `fit`'s frame; `fit.steps` stops every horizon's LAR path after
+/// that many steps (`None`: the full path, whose end is least squares).
 fn fit_gsc(
     params: &GskfParams,
     series: &[&[f64]],
-    steps: Option<usize>,
+    fit: steps::AxisFit,
 ) -> Result<GroupSparseCoder> {
-    let mut gsc =
-        GroupSparseCoder::params(params.window, params.horizons).relative(params.relative);
-    if let Some(s) = steps {
+    let mut gsc = GroupSparseCoder::params(params.window, params.horizons).relative(fit.relative);
+    if let Some(s) = fit.steps {
         gsc = gsc.lars(Lars::params().max_steps(s));
     }
     gsc.fit_many(series).map_err(sparse_error)
@@ -305,20 +311,21 @@ fn coder_json(gsc: &GroupSparseCoder) -> serde_json::Map<String, serde_json::Val
     m
 }
 
-/// The fields `keys` of a saved axis, allowing a `"relative": true` beside them, which must
-/// agree with `params.relative` (a coder read in the wrong frame would forecast wrongly).
+/// The fields `keys` of a saved axis and its frame: a `"relative": true` may stand beside
+/// them, and must agree with `params.relative` unless `params.choose_frame` (a coder read in
+/// the wrong frame would forecast wrongly).
 fn axis_fields<'a, const N: usize>(
     params: &GskfParams,
     ax: &At<'a>,
     keys: [&str; N],
-) -> Result<[At<'a>; N]> {
+) -> Result<([At<'a>; N], bool)> {
     let saved = match ax.value().get("relative") {
         None => false,
         Some(v) => v
             .as_bool()
             .ok_or_else(|| ax.error("`relative`: expected true or false"))?,
     };
-    if saved != params.relative {
+    if saved != params.relative && !params.choose_frame {
         let frame = |rel: bool| {
             if rel {
                 "the frame of each window's last value"
@@ -333,18 +340,22 @@ fn axis_fields<'a, const N: usize>(
             params.relative
         )));
     }
-    ax.fields_and(keys, &["relative"])
+    Ok((ax.fields_and(keys, &["relative"])?, saved))
 }
 
 /// Reads a coder back from its fields `a`, `b`, `residual_variances`, with the shape the
 /// options give (T x m).
-fn coder_from(params: &GskfParams, a: &At, b: &At, rv: &At) -> Result<GroupSparseCoder> {
+fn coder_from(
+    params: &GskfParams,
+    (a, b, rv): (&At, &At, &At),
+    relative: bool,
+) -> Result<GroupSparseCoder> {
     let t = params.horizons;
     let a_m = a.matrix(t, params.window)?;
     let b_v = b.vector(t, At::f64)?;
     let rv_v = rv.vector(t, |x| x.f64_min(0.0, false))?;
     GroupSparseCoder::from_parts(a_m, b_v, rv_v.as_slice().to_vec())
-        .map(|g| g.in_relative_frame(params.relative))
+        .map(|g| g.in_relative_frame(relative))
         .map_err(|e| a.error(e.to_string()))
 }
 
@@ -448,12 +459,12 @@ fn check_history(
     Ok(())
 }
 
-/// Every axis's GSC; `steps[a]` stops axis `a`'s LAR paths (the full path where `steps` is
+/// Every axis's GSC; `fits[a]` gives axis `a`'s frame and where its LAR paths stop (the full path in `params.relative`'s frame where `fits` is
 /// shorter).
 fn fit_axes(
     params: &GskfParams,
     train: &[Trajectory],
-    steps: &[Option<usize>],
+    fits: &[steps::AxisFit],
 ) -> Result<Vec<GroupSparseCoder>> {
     let dim = train
         .first()
@@ -471,11 +482,11 @@ fn fit_axes(
     let needed = params.window + params.horizons + 1;
     (0..dim)
         .map(|a| {
-            fit_gsc(
-                params,
-                &axis_series(train, a, needed),
-                steps.get(a).copied().flatten(),
-            )
+            let fit = fits.get(a).copied().unwrap_or(steps::AxisFit {
+                relative: params.relative,
+                steps: None,
+            });
+            fit_gsc(params, &axis_series(train, a, needed), fit)
         })
         .collect()
 }
@@ -535,8 +546,9 @@ impl Predictor for Gsc {
         let axes = axes_of("gsc", params)?
             .iter()
             .map(|ax| {
-                let [a, b, rv] = axis_fields(&self.params, ax, ["a", "b", "residual_variances"])?;
-                coder_from(&self.params, &a, &b, &rv)
+                let ([a, b, rv], rel) =
+                    axis_fields(&self.params, ax, ["a", "b", "residual_variances"])?;
+                coder_from(&self.params, (&a, &b, &rv), rel)
             })
             .collect::<Result<_>>()?;
         self.axes = axes;
@@ -725,12 +737,12 @@ impl Predictor for Gskf {
         let axes = axes_of("gskf", params)?
             .iter()
             .map(|ax| {
-                let [a, b, rv, q, correct] = axis_fields(
+                let ([a, b, rv, q, correct], rel) = axis_fields(
                     &self.params,
                     ax,
                     ["a", "b", "residual_variances", "q", "correct"],
                 )?;
-                let gsc = coder_from(&self.params, &a, &b, &rv)?;
+                let gsc = coder_from(&self.params, (&a, &b, &rv), rel)?;
                 let on = correct
                     .value()
                     .as_bool()

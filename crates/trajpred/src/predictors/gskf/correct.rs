@@ -21,7 +21,7 @@ pub(super) fn choose(
     params: &GskfParams,
     train: &[Trajectory],
     groups: &[usize],
-    steps: &[Option<usize>],
+    steps: &[super::steps::AxisFit],
 ) -> Result<(Vec<AxisFilter>, String)> {
     let (fold, k) = fold_of_trajectories(groups, CV_FOLDS, 0)?;
     let needed = params.window + params.horizons + 1;
