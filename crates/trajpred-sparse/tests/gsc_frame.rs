@@ -8,29 +8,28 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use trajpred_sparse::{GroupSparseCoder, Lars};
 
-/// A random walk with drift near 0: x_k = x_{k-1} + 1.5 + N(0, 0.5^2).
-fn walk(n: usize, seed: u64) -> Vec<f64> {
+/// `x_k = keep x_{k-1} + e_k`, `x_0 = 0`, `e_k ~ N(mean, sd^2)` seeded: with `keep = 1` a
+/// random walk (with drift `mean`), below 1 a series that wanders about 0.
+fn series(n: usize, seed: u64, keep: f64, (mean, sd): (f64, f64)) -> Vec<f64> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let step = Normal::new(1.5, 0.5).expect("normal");
+    let e = Normal::new(mean, sd).expect("normal");
     let mut x = vec![0.0];
     for _ in 1..n {
         let last = x[x.len() - 1];
-        x.push(last + step.sample(&mut rng));
+        x.push(keep * last + e.sample(&mut rng));
     }
     x
+}
+
+/// A random walk with drift near 0: x_k = x_{k-1} + 1.5 + N(0, 0.5^2).
+fn walk(n: usize, seed: u64) -> Vec<f64> {
+    series(n, seed, 1.0, (1.5, 0.5))
 }
 
 /// A series that wanders about 0 (x_k = 0.95 x_{k-1} + N(0, 2^2)): fitted in absolute
 /// values, the coder learns to pull towards that level.
 fn around_zero(n: usize, seed: u64) -> Vec<f64> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let e = Normal::new(0.0, 2.0).expect("normal");
-    let mut x = vec![0.0];
-    for _ in 1..n {
-        let last = x[x.len() - 1];
-        x.push(0.95 * last + e.sample(&mut rng));
-    }
-    x
+    series(n, seed, 0.95, (0.0, 2.0))
 }
 
 #[test]
