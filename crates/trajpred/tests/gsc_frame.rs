@@ -24,9 +24,11 @@ fn moved(tr: &Trajectory, c: [f64; 2]) -> Trajectory {
     Trajectory::from_axes(tr.times().to_vec(), vec![x, y]).unwrap()
 }
 
+/// A fixed frame: `relative`, without the choice.
 fn params(relative: bool) -> GskfParams {
     GskfParams {
         relative,
+        choose_frame: false,
         ..Default::default()
     }
 }
@@ -109,7 +111,7 @@ fn the_frame_is_saved_and_a_mismatch_on_loading_is_refused() {
 }
 
 #[test]
-fn with_choose_frame_held_out_groups_at_other_places_choose_the_relative_frame() {
+fn by_default_held_out_groups_at_other_places_choose_the_relative_frame() {
     // five groups (users), each wandering about its own place 2 km from the next: fitted in
     // absolute values on four of them, the coder pulls a held-out group's forecast towards
     // the others' places, so the folds choose the relative frame on both axes
@@ -122,10 +124,9 @@ fn with_choose_frame_held_out_groups_at_other_places_choose_the_relative_frame()
             groups.push(g as usize);
         }
     }
-    let choose = GskfParams {
-        choose_frame: true,
-        ..Default::default()
-    };
+    // the choice is the default
+    let choose = GskfParams::default();
+    assert!(choose.choose_frame);
     for p in [
         Box::new(Gsc::new(choose.clone()).unwrap()) as Box<dyn Predictor>,
         Box::new(Gskf::new(choose.clone()).unwrap()),
@@ -172,8 +173,12 @@ fn with_choose_frame_held_out_groups_at_other_places_choose_the_relative_frame()
             ));
         }
     }
-    // without the choice (the default) the same data keep absolute values
-    let mut plain = Gsc::new(GskfParams::default()).unwrap();
+    // without the choice the same data keep absolute values
+    let mut plain = Gsc::new(GskfParams {
+        choose_frame: false,
+        ..GskfParams::default()
+    })
+    .unwrap();
     plain.fit_grouped(&train, &groups).unwrap();
     let said = plain.fitted_summary().unwrap();
     assert!(

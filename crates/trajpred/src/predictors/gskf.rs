@@ -52,7 +52,8 @@ pub struct GskfParams {
     /// With `choose_steps` and trajectories of several groups, each axis also chooses its
     /// frame, absolute values or the frame of each window's last value, on the same held-out
     /// groups as its LAR steps (ties go to absolute values, the paper's); `relative` is then
-    /// only the frame of a fit without groups. Default `false` (see `docs/gskf.md`).
+    /// only the frame of a fit without groups. Default `true` (since 2026-12-07; see
+    /// `docs/gskf.md`); parameters saved before it read back as `false`.
     #[serde(default)]
     pub choose_frame: bool,
 }
@@ -66,7 +67,7 @@ impl Default for GskfParams {
             q_grid: vec![1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0],
             choose_steps: true,
             relative: false,
-            choose_frame: false,
+            choose_frame: true,
         }
     }
 }
