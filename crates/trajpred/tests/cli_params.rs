@@ -86,7 +86,7 @@ fn fit_then_evaluate_with_params_gives_the_table_of_evaluate_with_fitting() {
     assert_eq!(lines.len(), 4, "{summary}");
     assert!(lines[0].starts_with("kf-cv: q = "), "{summary}");
     assert!(
-        lines[1].starts_with("gsc: LAR steps chosen per axis")
+        lines[1].starts_with("gsc: frame and LAR steps chosen per axis")
             && lines[1].contains("(4 training segments"),
         "{summary}"
     );
