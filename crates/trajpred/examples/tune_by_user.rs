@@ -7,7 +7,7 @@
 //! cargo run --release -p trajpred --example tune_by_user -- geolife ../shared/data/geolife 5 55
 //! ```
 //! (dataset, path, `--max-gap`, `--min-points`; a fifth argument `gbm` scores
-//! `aligned-gbm`'s variants instead, with a sixth `1` to `4` for the first to fourth round
+//! `aligned-gbm`'s variants instead, with a sixth `1` to `5` for the first to fifth round
 //! of them; the split is `--split by-user`,
 //! `--train-fraction 0.3`, `--seed 0`, the evaluation `--history 20 --horizon 5`.)
 
@@ -117,6 +117,14 @@ fn main() -> Result<()> {
                 "gbm 1 reweighted pass, no shape features",
                 AlignedGbmParams {
                     shape_features: false,
+                    ..Default::default()
+                },
+            )?;
+        } else if arg(6, "1") == "5" {
+            gbm(
+                "gbm mirrored origins",
+                AlignedGbmParams {
+                    mirror: true,
                     ..Default::default()
                 },
             )?;

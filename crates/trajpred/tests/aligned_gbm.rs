@@ -260,3 +260,51 @@ fn reweighted_passes_move_the_fit_from_the_mean_to_the_median() {
     assert!(once < 10.0, "one reweighted pass: {once} m ahead");
     assert!(thrice < 0.5 * once, "three passes: {thrice} m ahead");
 }
+
+/// Tracks that turn at a constant rate, left (`side = 1`) or right (`side = -1`): 8 m/s,
+/// turning 0.1 rad/s, starting on heading `k` radians, irregular times.
+fn turning(k: usize, side: f64) -> Trajectory {
+    let n = 45;
+    let t: Vec<f64> = (0..n)
+        .map(|i| i as f64 + 0.3 * ((i * 5 + k) % 4) as f64)
+        .collect();
+    let (v, w, h0) = (8.0, 0.1 * side, k as f64);
+    let x = t
+        .iter()
+        .map(|&t| 40.0 * k as f64 + v / w * ((h0 + w * t).sin() - h0.sin()))
+        .collect();
+    let y = t
+        .iter()
+        .map(|&t| -30.0 * k as f64 - v / w * ((h0 + w * t).cos() - h0.cos()))
+        .collect();
+    Trajectory::from_axes(t, vec![x, y]).expect("finite, increasing")
+}
+
+#[test]
+fn mirrored_origins_teach_the_turns_the_training_tracks_never_made() {
+    // trained on left turns only; tested on right turns at new headings
+    let train: Vec<Trajectory> = (0..30).map(|k| turning(k, 1.0)).collect();
+    let right: Vec<Trajectory> = (40..46).map(|k| turning(k, -1.0)).collect();
+    let left: Vec<Trajectory> = (40..46).map(|k| turning(k, 1.0)).collect();
+    let fit = |mirror: bool| {
+        let mut m = AlignedGbm::new(AlignedGbmParams { mirror, ..params() }).expect("valid");
+        m.fit(&train).expect("fits");
+        m
+    };
+    let (plain, mirrored) = (fit(false), fit(true));
+    let cv = mean_error(&CvTime::new(), &right);
+    let (on_plain, on_mirrored) = (mean_error(&plain, &right), mean_error(&mirrored, &right));
+    assert!(cv > 1.0, "cv-time {cv}");
+    // without the mirror the right turns are forecast as left turns: worse than no model
+    assert!(on_plain > cv, "plain {on_plain} against cv-time {cv}");
+    assert!(
+        on_mirrored < 0.3 * cv,
+        "mirrored {on_mirrored} against cv-time {cv}"
+    );
+    // and the left turns it was trained on stay learned
+    let on_left = mean_error(&mirrored, &left);
+    assert!(on_left < 0.3 * cv, "left turns {on_left}");
+    // the mirror doubles the training origins
+    let said = |m: &AlignedGbm| m.fitted_summary().expect("fitted");
+    assert_ne!(said(&plain), said(&mirrored));
+}

@@ -54,6 +54,11 @@ pub struct AlignedGbmParams {
     /// The smallest residual (m) a weight is computed from, so that an origin fitted
     /// exactly does not take all the weight.
     pub robust_floor: f64,
+    /// Also fit every training origin mirrored across its track (every across-track
+    /// feature and target negated: a left turn seen as the right turn it mirrors), which
+    /// doubles the origins and the fitting time. Default `false`.
+    #[serde(default)]
+    pub mirror: bool,
 }
 
 impl Default for AlignedGbmParams {
@@ -71,6 +76,7 @@ impl Default for AlignedGbmParams {
             shape_features: true,
             robust_passes: 1,
             robust_floor: 1.0,
+            mirror: false,
         }
     }
 }
@@ -135,6 +141,25 @@ impl AlignedGbmParams {
     /// with the shape features, 18 fitted and 8 spread features more.
     fn features(&self) -> usize {
         3 * self.lags + 4 + if self.shape_features { 26 } else { 0 }
+    }
+
+    /// Per feature, `-1` where mirroring the track across its heading negates it (the
+    /// across-track components), else `1`; in the order [`Origin::new`] writes them.
+    fn mirror_signs(&self) -> Vec<f64> {
+        let mut s = vec![1.0, 1.0];
+        for _ in 0..self.lags {
+            s.extend([1.0, -1.0, 1.0]);
+        }
+        s.extend([1.0, -1.0]);
+        if self.shape_features {
+            // three lines (position, velocity) and a parabola (position, velocity,
+            // acceleration), each (along, across); then the legs' spread, unsigned
+            for _ in 0..9 {
+                s.extend([1.0, -1.0]);
+            }
+            s.extend([1.0; 8]);
+        }
+        s
     }
 }
 
@@ -451,7 +476,8 @@ impl AlignedGbm {
         })
     }
 
-    /// The column-major features and targets of step `s`, at most `max_samples` origins.
+    /// The column-major features and targets of step `s`, at most `max_samples` origins
+    /// (each twice with [`AlignedGbmParams::mirror`]).
     fn step_data(&self, train: &[Trajectory], s: usize) -> (Vec<f64>, usize, [Vec<f64>; 2]) {
         let p = &self.params;
         let mut all = Samples::default();
@@ -464,13 +490,23 @@ impl AlignedGbm {
         } else {
             (0..n).collect()
         };
-        let mut data = Vec::with_capacity(keep.len() * p.features());
-        for j in 0..p.features() {
-            data.extend(keep.iter().map(|&i| all.rows[i][j]));
+        let copies: &[f64] = if p.mirror { &[1.0, -1.0] } else { &[1.0] };
+        let signs = p.mirror_signs();
+        let mut data = Vec::with_capacity(copies.len() * keep.len() * p.features());
+        for (j, sign) in signs.iter().enumerate() {
+            for c in copies {
+                // mirrored: the across-track features negated
+                let f = if *c < 0.0 { *sign } else { 1.0 };
+                data.extend(keep.iter().map(|&i| f * all.rows[i][j]));
+            }
         }
-        let along = keep.iter().map(|&i| all.along[i]).collect();
-        let across = keep.iter().map(|&i| all.across[i]).collect();
-        (data, keep.len(), [along, across])
+        let mut along = Vec::with_capacity(copies.len() * keep.len());
+        let mut across = Vec::with_capacity(copies.len() * keep.len());
+        for c in copies {
+            along.extend(keep.iter().map(|&i| all.along[i]));
+            across.extend(keep.iter().map(|&i| c * all.across[i]));
+        }
+        (data, copies.len() * keep.len(), [along, across])
     }
 }
 
