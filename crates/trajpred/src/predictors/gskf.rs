@@ -23,7 +23,10 @@ use trajpred_kalman::{Ikf, Innovation, LinearObservation, LinearTransition};
 use trajpred_sparse::{GroupSparseCoder, Lars};
 
 mod correct;
+mod diverged;
 mod steps;
+
+pub use diverged::Diverged;
 
 /// Parameters of [`Gsc`] and [`Gskf`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -196,10 +199,29 @@ impl AxisFilter {
             .map_err(kalman_error)?
             + &r;
         let mut p_prior = DMatrix::zeros(t, t);
-        for _ in 0..5000 {
+        let from = post.norm();
+        let diverged = |iterations: usize, to: f64, cause: String| {
+            Error::method(
+                "gskf",
+                Diverged {
+                    q,
+                    from,
+                    to,
+                    iterations,
+                    cause,
+                },
+            )
+        };
+        // an error at the first iteration is one of the inputs (`R`, `Q`), later ones are
+        // the recursion's
+        let failed = |it: usize, to: f64, e: trajpred_kalman::KalmanError| match it {
+            0 => kalman_error(e),
+            _ => diverged(it, to, e.to_string()),
+        };
+        for it in 0..5000 {
             p_prior = ikf
                 .propagate_covariance::<f64, Dyn, Dyn>(&post)
-                .map_err(kalman_error)?;
+                .map_err(|e| failed(it, post.norm(), e))?;
             let prior = Gaussian {
                 mean: DVector::zeros(t),
                 covariance: p_prior.clone(),
@@ -207,7 +229,7 @@ impl AxisFilter {
             let innov = Innovation::new(DVector::zeros(t), s.clone())?;
             let next = ikf
                 .correct(&prior, &innov)
-                .map_err(kalman_error)?
+                .map_err(|e| failed(it, p_prior.norm(), e))?
                 .covariance;
             let change = (&next - &post).norm() / next.norm().max(1e-300);
             post = next;
@@ -217,9 +239,7 @@ impl AxisFilter {
             }
         }
         if p_prior.iter().any(|v| !v.is_finite()) {
-            return Err(Error::NotPositiveDefinite {
-                what: "GSKF covariance recursion (diverged)",
-            });
+            return Err(diverged(5000, p_prior.norm(), "a non-finite P".into()));
         }
         Ok(AxisFilter {
             gsc,

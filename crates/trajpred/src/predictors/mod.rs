@@ -20,7 +20,7 @@ pub use aligned_ridge::{AlignedRidge, AlignedRidgeParams};
 pub use auto::{Auto, AutoParams, CandidateScore, DEFAULT_CANDIDATES, cross_validate};
 pub use blend::{Blend, BlendParams};
 pub use cv_time::{CvTime, LastPosition};
-pub use gskf::{Gsc, Gskf, GskfParams};
+pub use gskf::{Diverged, Gsc, Gskf, GskfParams};
 pub use hmm::{Hmm, HmmParams, MAX_HMM_STATES};
 pub use imm::{ImmParams, ImmPredictor};
 pub use kf_dynamic::{Continuation, KfDynamic, KfDynamicParams, NaiveKf};

@@ -29,12 +29,15 @@ pub(super) fn choose(
     // per axis, per option (0: no correction, 1..: the grid), per fold: absolute errors
     // and count
     let mut sae: Vec<Vec<Vec<(f64, usize)>>> = Vec::new();
+    // per axis, per option: why it first failed, for the summary
+    let mut why: Vec<Vec<Option<String>>> = Vec::new();
     for f in 0..k {
         let (fit, _, held) = fold_split(train, groups, &fold, f);
         let Ok(coders) = fit_axes(params, &fit, steps) else {
             continue;
         };
         sae.resize(coders.len(), vec![vec![(0.0, 0); k]; grid.len() + 1]);
+        why.resize(coders.len(), vec![None; grid.len() + 1]);
         for (a, gsc) in coders.into_iter().enumerate() {
             let series = axis_series(&held, a, needed);
             let scale = mean_residual_variance(&gsc);
@@ -46,9 +49,13 @@ pub(super) fn choose(
                     None => AxisFilter::plain(gsc.clone()),
                     Some(&g) => AxisFilter::new(gsc.clone(), (g * scale).max(1e-300)),
                 };
-                let Ok(filter) = filter else {
-                    sae[a][o][f].0 = f64::INFINITY;
-                    continue;
+                let filter = match filter {
+                    Ok(filter) => filter,
+                    Err(e) => {
+                        sae[a][o][f].0 = f64::INFINITY;
+                        why[a][o].get_or_insert_with(|| format!("fold {f}: {e}"));
+                        continue;
+                    }
                 };
                 let (_, e, n) = errors(&filter, &series)?;
                 sae[a][o][f] = (e, n);
@@ -72,17 +79,21 @@ pub(super) fn choose(
             (Some(o), Some((mean, se))) if mae(o) < mae(0) && mean > se => o,
             _ => 0,
         };
-        let shown = |e: f64| match e.is_finite() {
-            true => format!("{e:.4e}"),
-            false => "failed in a fold".into(),
+        let shown = |o: usize| {
+            let e = mae(o);
+            match (e.is_finite(), why.get(a).and_then(|w| w[o].as_deref())) {
+                (true, _) => format!("{e:.4e}"),
+                (false, Some(reason)) => format!("failed ({reason})"),
+                (false, None) => "failed in a fold".into(),
+            }
         };
         let _ = write!(
             said,
             "; held-out mean absolute error, axis {a}: GSC alone {}",
-            shown(mae(0))
+            shown(0)
         );
         for (j, g) in grid.iter().enumerate() {
-            let _ = write!(said, ", q = {:.3e}: {}", g * scale, shown(mae(j + 1)));
+            let _ = write!(said, ", q = {:.3e}: {}", g * scale, shown(j + 1));
         }
         if let (Some(o), Some((mean, se))) = (best_q, gain) {
             let _ = write!(
