@@ -24,6 +24,12 @@ pub struct MethodOptions {
     /// score their held-out folds by: the run's history, horizon, stride and origins.
     #[serde(default)]
     pub eval: crate::harness::EvalConfig,
+    /// Held-out forecasts shared by the methods built with these options that
+    /// cross-validate candidates (`auto`, `blend`): with one cache, a run that holds both
+    /// fits each candidate on each fold once. `None` (the default): each computes its own.
+    /// Not saved.
+    #[serde(skip)]
+    pub held_out: Option<std::sync::Arc<crate::predictors::HeldOutCache>>,
 }
 
 impl Default for MethodOptions {
@@ -36,6 +42,7 @@ impl Default for MethodOptions {
             horizons: 6,
             epochs: None,
             eval: crate::harness::EvalConfig::default(),
+            held_out: None,
         }
     }
 }

@@ -1,6 +1,7 @@
 //! `auto`: the method chosen per dataset by cross-validation by group on the training part
 //! only (issue 27, "model selection without peeking").
 
+use super::cv_cache::{self, FoldJob};
 use super::fitted::At;
 use super::invalid;
 use crate::harness::{self, EvalConfig};
@@ -254,14 +255,32 @@ impl Auto {
     fn score(&self, name: &str, train: &[Trajectory], groups: &[usize]) -> Result<CandidateScore> {
         let build = || registry::build(name, &self.options);
         let (p, e) = (&self.params, &self.params.eval);
-        cross_validate(name, &build, train, groups, p.folds, p.seed, e)
+        let (fold, k) = fold_of_trajectories(groups, p.folds, p.seed)?;
+        let shared = self.options.held_out.as_deref().map(|c| {
+            (
+                c,
+                cv_cache::fingerprint(train, groups, &fold, e, &self.options),
+            )
+        });
+        let job = FoldJob {
+            name,
+            build: &build,
+            train,
+            groups,
+            fold: &fold,
+            eval: e,
+            shared,
+        };
+        score_folds(&job, k)
     }
 }
 
 /// The cross-validated score of one method: `build` makes it unfitted; for each of `folds`
 /// folds of groups ([`harness::group_folds`] with `seed`) it is fitted on the other folds and
-/// evaluated on the held-out one by [`harness::evaluate`] with `eval`. What [`Auto`] ranks its
-/// candidates by, public so that a tuning script can score variants the same way.
+/// its forecasts on the held-out one ([`harness::collect_forecasts`] with `eval`, the
+/// origins [`harness::evaluate`] scores) are scored by their mean Euclidean error, the
+/// number the leaderboard reports. What [`Auto`] ranks its candidates by, public so that a
+/// tuning script can score variants the same way.
 pub fn cross_validate(
     name: &str,
     build: &dyn Fn() -> Result<Box<dyn Predictor>>,
@@ -272,8 +291,23 @@ pub fn cross_validate(
     eval: &EvalConfig,
 ) -> Result<CandidateScore> {
     let (fold, k) = fold_of_trajectories(groups, folds, seed)?;
+    let job = FoldJob {
+        name,
+        build,
+        train,
+        groups,
+        fold: &fold,
+        eval,
+        shared: None,
+    };
+    score_folds(&job, k)
+}
+
+/// [`cross_validate`] over the `k` folds of `job`.
+fn score_folds(job: &FoldJob<'_>, k: usize) -> Result<CandidateScore> {
+    let dim = job.train.first().map_or(1, |t| t.dim());
     let mut s = CandidateScore {
-        method: name.to_string(),
+        method: job.name.to_string(),
         fold_errors: Vec::with_capacity(k),
         fold_forecasts: Vec::with_capacity(k),
         pooled_error: f64::INFINITY,
@@ -281,27 +315,32 @@ pub fn cross_validate(
     };
     let (mut sum, mut n) = (0.0, 0usize);
     for f in 0..k {
-        let (fit, fit_groups, held) = fold_split(train, groups, &fold, f);
-        let mut p = build()?;
-        if let Err(e) = p.fit_grouped(&fit, &fit_groups) {
-            s.failure = Some(format!("fold {f}: fit: {e}"));
-            return Ok(s);
-        }
-        let r = harness::evaluate(p.as_ref(), &held, eval, None)?;
-        if r.failures > 0 {
-            s.failure = Some(format!(
-                "fold {f}: {} forecasts refused ({})",
-                r.failures,
-                r.first_failure.unwrap_or_default()
-            ));
-            return Ok(s);
-        }
-        s.fold_errors.push(r.mean_euclidean_all);
-        s.fold_forecasts.push(r.forecasts);
-        if r.forecasts > 0 {
-            sum += r.mean_euclidean_all * r.forecasts as f64;
-            n += r.forecasts;
-        }
+        let got = cv_cache::fold_forecasts(job, f)?;
+        let (forecast, truth) = match got.as_ref() {
+            Ok(pair) => pair,
+            Err(why) => {
+                s.failure = Some(why.clone());
+                return Ok(s);
+            }
+        };
+        // one distance per forecast step
+        let (fold_sum, steps) =
+            forecast
+                .chunks(dim)
+                .zip(truth.chunks(dim))
+                .fold((0.0, 0usize), |(e, c), (p, t)| {
+                    let d2: f64 = p.iter().zip(t).map(|(a, b)| (a - b) * (a - b)).sum();
+                    (e + d2.sqrt(), c + 1)
+                });
+        let origins = steps / job.eval.horizon.max(1);
+        s.fold_errors.push(if steps > 0 {
+            fold_sum / steps as f64
+        } else {
+            f64::NAN
+        });
+        s.fold_forecasts.push(origins);
+        sum += fold_sum;
+        n += steps;
     }
     if n == 0 {
         s.failure = Some("no origin in any held-out fold".into());

@@ -1,19 +1,18 @@
 //! `blend`: a weighted mean of several methods' forecasts, the weights of each forecast step
 //! chosen by greedy ensemble selection on forecasts held out by group (issue 27).
 
-use super::auto::{
-    DEFAULT_CANDIDATES, check_selection, fold_of_trajectories, fold_split, load_member,
-};
+use super::auto::{DEFAULT_CANDIDATES, check_selection, fold_of_trajectories, load_member};
+use super::cv_cache::{self, FoldJob};
 use super::fitted::{At, exact_vec};
 use super::invalid;
 use held_out::{HeldOut, quantile_edges, regime_of, speed_at};
 
 mod held_out;
-use crate::harness::{self, EvalConfig, ForecastPair};
+use crate::harness::EvalConfig;
 use crate::registry::{self, MethodOptions};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
-use trajpred_core::{Error, Forecast, Point, Predictor, Result, Trajectory};
+use trajpred_core::{Error, Forecast, Predictor, Result, Trajectory};
 
 /// The most forecast steps a saved blend may hold weights for.
 const MAX_STEPS: usize = 10_000;
@@ -69,7 +68,7 @@ struct Member {
 /// At [`Predictor::fit_grouped`] the training trajectories' groups (users, vehicles) are
 /// dealt into [`BlendParams::folds`] folds; every candidate is fitted on all folds but one
 /// and forecasts the held-out one on the harness's rolling origin
-/// ([`harness::collect_forecasts`] with [`BlendParams::eval`]), so every training origin
+/// ([`crate::harness::collect_forecasts`] with [`BlendParams::eval`]), so every training origin
 /// gets one held-out forecast per candidate. For each step `k` the weights are then chosen
 /// by greedy selection with replacement (Caruana et al., 2004): starting empty, each of
 /// [`BlendParams::rounds`] rounds adds the candidate that most lowers the mean Euclidean
@@ -193,29 +192,37 @@ impl Blend {
         let cands = &self.params.candidates;
         let (mut truth, mut speed, mut fold_of) = (Vec::new(), Vec::new(), Vec::new());
         let mut forecasts: Vec<Option<Vec<f64>>> = vec![Some(Vec::new()); cands.len()];
+        let shared = self.options.held_out.as_deref().map(|c| {
+            let e = &self.params.eval;
+            (
+                c,
+                cv_cache::fingerprint(train, groups, &fold, e, &self.options),
+            )
+        });
         for f in 0..k {
-            let (fit, fit_groups, held) = fold_split(train, groups, &fold, f);
+            let held: Vec<Trajectory> = train
+                .iter()
+                .zip(&fold)
+                .filter(|&(_, &g)| g == f)
+                .map(|(t, _)| t.clone())
+                .collect();
             let mut fold_truth: Option<Vec<f64>> = None;
             for (c, name) in cands.iter().enumerate() {
                 let Some(out) = forecasts[c].as_mut() else {
                     continue;
                 };
-                let mut p = registry::build(name, &self.options)?;
-                let got = match p.fit_grouped(&fit, &fit_groups) {
-                    Err(e) => Err(format!("fold {f}: fit: {e}")),
-                    Ok(()) => harness::collect_forecasts(p.as_ref(), &held, &self.params.eval)?
-                        .map_err(|why| format!("fold {f}: {why}")),
+                let build = || registry::build(name, &self.options);
+                let job = FoldJob {
+                    name,
+                    build: &build,
+                    train,
+                    groups,
+                    fold: &fold,
+                    eval: &self.params.eval,
+                    shared,
                 };
-                match got {
-                    Ok(pairs) => {
-                        let flat = |pick: fn(&ForecastPair) -> &Vec<Point>| {
-                            pairs
-                                .iter()
-                                .flat_map(|pair| pick(pair).iter())
-                                .flat_map(|x| x.as_ref().to_vec())
-                                .collect::<Vec<f64>>()
-                        };
-                        let t = flat(|p| &p.1);
+                match cv_cache::fold_forecasts(&job, f)?.as_ref() {
+                    Ok((p, t)) => {
                         match &fold_truth {
                             Some(prev) if prev.len() != t.len() => {
                                 notes.push(format!("{name}: out (fold {f}: other origins)"));
@@ -223,9 +230,9 @@ impl Blend {
                                 continue;
                             }
                             Some(_) => {}
-                            None => fold_truth = Some(t),
+                            None => fold_truth = Some(t.clone()),
                         }
-                        out.extend(flat(|p| &p.0));
+                        out.extend_from_slice(p);
                     }
                     Err(why) => {
                         notes.push(format!("{name}: out ({why})"));

@@ -17,6 +17,10 @@ pub(crate) fn custom_options(kf_q: f64, seed: u64, eval: EvalConfig) -> MethodOp
         horizons: MethodOptions::default().horizons.max(eval.horizon),
         // what `auto` and `aligned-ridge` score their held-out folds by
         eval,
+        // `auto` and `blend` fit each candidate on each fold once between them
+        held_out: Some(std::sync::Arc::new(
+            trajpred::predictors::HeldOutCache::new(),
+        )),
         ..Default::default()
     }
 }
