@@ -1,13 +1,17 @@
-//! `auto` (choice by cross-validation by group on the training part) and the folds it and
-//! `evaluate --folds` deal users into.
+//! `auto` (choice by cross-validation by group on the training part), the folds it and
+//! `evaluate --folds` deal users into, and the held-out forecasts `auto` and `blend` share
+//! through `MethodOptions::held_out` (the same choices and weights as without it, each
+//! candidate fitted once per fold between them, fold scores equal to the leaderboard's
+//! mean error).
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use std::sync::Arc;
 use trajpred::dataset::{Dataset, Segment, Segmentation};
-use trajpred::harness::{EvalConfig, Split, group_folds, group_ids};
-use trajpred::predictors::{Auto, AutoParams};
+use trajpred::harness::{self, EvalConfig, Split, group_folds, group_ids};
+use trajpred::predictors::{Auto, AutoParams, Blend, BlendParams, HeldOutCache};
 use trajpred::protocol::{self, MethodSpec, Protocol, Silent};
-use trajpred::registry::MethodOptions;
+use trajpred::registry::{self, MethodOptions};
 use trajpred_core::{Predictor, Trajectory};
 
 const EVAL: EvalConfig = EvalConfig {
@@ -267,4 +271,135 @@ fn folds_deal_every_user_into_exactly_one_test_part() {
     let mut all: Vec<String> = segments.iter().map(|s| s.id.clone()).collect();
     all.sort();
     assert_eq!(tested, all);
+}
+
+const SHARED_CANDIDATES: &[&str] = &["cv-time", "last-position", "poly1", "kf-cv"];
+
+/// Tracks that walk, turn and stand, with noisy fixes at irregular times.
+fn wandering(seed: u64, n: usize) -> Vec<Trajectory> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..n)
+        .map(|_| {
+            let (mut t, mut x, mut y) = (0.0, 0.0, 0.0);
+            let (mut v, mut h): (f64, f64) = (
+                rng.random_range(0.0..3.0),
+                rng.random_range(0.0..std::f64::consts::TAU),
+            );
+            let (mut times, mut xs, mut ys) = (Vec::new(), Vec::new(), Vec::new());
+            for _ in 0..40 {
+                times.push(t);
+                xs.push(x + rng.random_range(-2.0..2.0));
+                ys.push(y + rng.random_range(-2.0..2.0));
+                let dt = rng.random_range(1.0..3.0);
+                h += rng.random_range(-0.3..0.3);
+                v = (v + rng.random_range(-0.5..0.5)).max(0.0);
+                x += v * h.cos() * dt;
+                y += v * h.sin() * dt;
+                t += dt;
+            }
+            Trajectory::from_axes(times, vec![xs, ys]).unwrap()
+        })
+        .collect()
+}
+
+fn options_with(cache: Option<Arc<HeldOutCache>>) -> MethodOptions {
+    MethodOptions {
+        eval: EVAL,
+        held_out: cache,
+        ..Default::default()
+    }
+}
+
+fn shared_auto(o: &MethodOptions) -> Auto {
+    let params = AutoParams {
+        candidates: SHARED_CANDIDATES.iter().map(|s| s.to_string()).collect(),
+        eval: EVAL,
+        ..Default::default()
+    };
+    Auto::new(params, o.clone()).unwrap()
+}
+
+fn shared_blend(o: &MethodOptions) -> Blend {
+    let params = BlendParams {
+        candidates: SHARED_CANDIDATES.iter().map(|s| s.to_string()).collect(),
+        eval: EVAL,
+        ..Default::default()
+    };
+    Blend::new(params, o.clone()).unwrap()
+}
+
+#[test]
+fn auto_and_blend_share_their_folds_and_choose_as_without() {
+    let train = wandering(3, 20);
+    let groups: Vec<usize> = (0..20).map(|i| i / 3).collect();
+    // without a cache
+    let mut a0 = shared_auto(&options_with(None));
+    a0.fit_grouped(&train, &groups).unwrap();
+    let mut b0 = shared_blend(&options_with(None));
+    b0.fit_grouped(&train, &groups).unwrap();
+    // with one cache for both
+    let cache = Arc::new(HeldOutCache::new());
+    let shared = options_with(Some(cache.clone()));
+    let mut a1 = shared_auto(&shared);
+    a1.fit_grouped(&train, &groups).unwrap();
+    let entries = cache.len();
+    assert_eq!(
+        entries,
+        SHARED_CANDIDATES.len() * 5,
+        "every candidate on every fold"
+    );
+    assert_eq!(cache.hits(), 0);
+    let mut b1 = shared_blend(&shared);
+    b1.fit_grouped(&train, &groups).unwrap();
+    // the blend read every fold of every candidate from the cache
+    assert_eq!(cache.hits(), entries);
+    assert_eq!(cache.len(), entries);
+    assert_eq!(a1.chosen(), a0.chosen());
+    assert_eq!(a1.scores(), a0.scores());
+    assert_eq!(b1.fitted_params().unwrap(), b0.fitted_params().unwrap());
+    // other training data replace the entries instead of reading them
+    let other = wandering(4, 20);
+    let mut a2 = shared_auto(&shared);
+    a2.fit_grouped(&other, &groups).unwrap();
+    assert_eq!(cache.hits(), entries, "no stale entry is read");
+    assert_eq!(cache.len(), entries, "the old set was dropped");
+    let mut a3 = shared_auto(&options_with(None));
+    a3.fit_grouped(&other, &groups).unwrap();
+    assert_eq!(a2.scores(), a3.scores());
+}
+
+#[test]
+fn a_fold_score_is_the_leaderboards_mean_error_of_that_fold() {
+    let train = wandering(5, 15);
+    let groups: Vec<usize> = (0..15).map(|i| i / 3).collect();
+    let mut a = shared_auto(&options_with(None));
+    a.fit_grouped(&train, &groups).unwrap();
+    // the same folds by hand: fitted on four, `harness::evaluate` on the fifth
+    // groups are labelled 0..5, so a trajectory's fold is its label's
+    let of_label = group_folds(5, 5, 0).unwrap();
+    let fold: Vec<usize> = groups.iter().map(|&g| of_label[g]).collect();
+    for s in a.scores() {
+        for (f, &score) in s.fold_errors.iter().enumerate() {
+            let (mut fit, mut fit_groups, mut held) = (Vec::new(), Vec::new(), Vec::new());
+            for (i, tr) in train.iter().enumerate() {
+                if fold[i] == f {
+                    held.push(tr.clone());
+                } else {
+                    fit.push(tr.clone());
+                    fit_groups.push(groups[i]);
+                }
+            }
+            let mut p = registry::build(&s.method, &options_with(None)).unwrap();
+            p.fit_grouped(&fit, &fit_groups).unwrap();
+            let r = harness::evaluate(p.as_ref(), &held, &EVAL, None).unwrap();
+            assert_eq!(r.forecasts, s.fold_forecasts[f], "{} fold {f}", s.method);
+            let tol = 1e-12 * r.mean_euclidean_all;
+            assert!(
+                (r.mean_euclidean_all - score).abs() <= tol,
+                "{} fold {f}: {score} against the harness's {}",
+                s.method,
+                r.mean_euclidean_all
+            );
+        }
+    }
 }

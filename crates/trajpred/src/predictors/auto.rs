@@ -256,21 +256,7 @@ impl Auto {
         let build = || registry::build(name, &self.options);
         let (p, e) = (&self.params, &self.params.eval);
         let (fold, k) = fold_of_trajectories(groups, p.folds, p.seed)?;
-        let shared = self.options.held_out.as_deref().map(|c| {
-            (
-                c,
-                cv_cache::fingerprint(train, groups, &fold, e, &self.options),
-            )
-        });
-        let job = FoldJob {
-            name,
-            build: &build,
-            train,
-            groups,
-            fold: &fold,
-            eval: e,
-            shared,
-        };
+        let job = FoldJob::new(name, &build, (train, groups), &fold, e, &self.options);
         score_folds(&job, k)
     }
 }

@@ -192,13 +192,6 @@ impl Blend {
         let cands = &self.params.candidates;
         let (mut truth, mut speed, mut fold_of) = (Vec::new(), Vec::new(), Vec::new());
         let mut forecasts: Vec<Option<Vec<f64>>> = vec![Some(Vec::new()); cands.len()];
-        let shared = self.options.held_out.as_deref().map(|c| {
-            let e = &self.params.eval;
-            (
-                c,
-                cv_cache::fingerprint(train, groups, &fold, e, &self.options),
-            )
-        });
         for f in 0..k {
             let held: Vec<Trajectory> = train
                 .iter()
@@ -212,15 +205,8 @@ impl Blend {
                     continue;
                 };
                 let build = || registry::build(name, &self.options);
-                let job = FoldJob {
-                    name,
-                    build: &build,
-                    train,
-                    groups,
-                    fold: &fold,
-                    eval: &self.params.eval,
-                    shared,
-                };
+                let (e, o) = (&self.params.eval, &self.options);
+                let job = FoldJob::new(name, &build, (train, groups), &fold, e, o);
                 match cv_cache::fold_forecasts(&job, f)?.as_ref() {
                     Ok((p, t)) => {
                         match &fold_truth {

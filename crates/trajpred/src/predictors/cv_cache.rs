@@ -124,6 +124,34 @@ pub(crate) struct FoldJob<'a> {
     pub shared: Option<(&'a HeldOutCache, u64)>,
 }
 
+impl<'a> FoldJob<'a> {
+    /// The job of candidate `name` (made by `build`) on the folds `fold` of `train`, shared
+    /// through `options.held_out` when it holds a cache (the fingerprint is then computed
+    /// here).
+    pub fn new(
+        name: &'a str,
+        build: &'a dyn Fn() -> Result<Box<dyn Predictor>>,
+        (train, groups): (&'a [Trajectory], &'a [usize]),
+        fold: &'a [usize],
+        eval: &'a EvalConfig,
+        options: &'a MethodOptions,
+    ) -> Self {
+        let shared = options
+            .held_out
+            .as_deref()
+            .map(|c| (c, fingerprint(train, groups, fold, eval, options)));
+        FoldJob {
+            name,
+            build,
+            train,
+            groups,
+            fold,
+            eval,
+            shared,
+        }
+    }
+}
+
 /// The forecasts of `job.name` (made by `job.build`) fitted on the folds other than `f` and
 /// run over fold `f` (the harness's rolling origins, [`harness::collect_forecasts`]), from
 /// the cache when it holds them.
