@@ -1,9 +1,10 @@
 //! `aligned-gbm`: gradient-boosted trees that correct the last velocity, learned in the
 //! heading-aligned frame of `aligned-ridge` (issue 27).
 
+use super::aligned_features::{Layout, Origin};
 use super::fitted::At;
 use super::trees::Ensemble;
-use super::{Heading, horizontal_axes as xy, invalid};
+use super::{horizontal_axes as xy, invalid};
 use forust_ml::gradientbooster::{GrowPolicy, MissingNodeTreatment};
 use forust_ml::objective::ObjectiveType;
 use forust_ml::sampler::SampleMethod;
@@ -82,6 +83,20 @@ impl Default for AlignedGbmParams {
 }
 
 impl AlignedGbmParams {
+    /// The features the trees see.
+    fn layout(&self) -> Layout {
+        Layout {
+            lags: self.lags,
+            window: self.window,
+            shape: self.shape_features,
+        }
+    }
+
+    /// Features per origin.
+    fn features(&self) -> usize {
+        self.layout().count()
+    }
+
     fn validate(&self) -> Result<()> {
         let at_least_one = |name, v: usize| {
             if v == 0 {
@@ -135,188 +150,6 @@ impl AlignedGbmParams {
         }
         Ok(())
     }
-
-    /// Features per origin: the last speed, the mean interval, the rotated velocity and
-    /// duration of each of the `k` last legs, and the rotated mean velocity of the window;
-    /// with the shape features, 18 fitted and 8 spread features more.
-    fn features(&self) -> usize {
-        3 * self.lags + 4 + if self.shape_features { 26 } else { 0 }
-    }
-
-    /// Per feature, `-1` where mirroring the track across its heading negates it (the
-    /// across-track components), else `1`; in the order [`Origin::new`] writes them.
-    fn mirror_signs(&self) -> Vec<f64> {
-        let mut s = vec![1.0, 1.0];
-        for _ in 0..self.lags {
-            s.extend([1.0, -1.0, 1.0]);
-        }
-        s.extend([1.0, -1.0]);
-        if self.shape_features {
-            // three lines (position, velocity) and a parabola (position, velocity,
-            // acceleration), each (along, across); then the legs' spread, unsigned
-            for _ in 0..9 {
-                s.extend([1.0, -1.0]);
-            }
-            s.extend([1.0; 8]);
-        }
-        s
-    }
-}
-
-/// One origin described in the frame where its last velocity points along +x.
-struct Origin {
-    /// The heading.
-    u: Heading,
-    /// The last velocity, rotated (`(|v0|, 0)` unless it is zero).
-    v0: (f64, f64),
-    /// The mean interval of the window, s.
-    delta: f64,
-    /// The features, [`AlignedGbmParams::features`] of them.
-    feats: Vec<f64>,
-}
-
-impl Origin {
-    /// The origin `o` of a track (`o >= lags`); `y` is zeros for 1-D tracks.
-    fn new(p: &AlignedGbmParams, t: &[f64], x: &[f64], y: &[f64], o: usize) -> Self {
-        let vel = |j: usize| {
-            let dt = t[o - j] - t[o - j - 1];
-            (
-                (x[o - j] - x[o - j - 1]) / dt,
-                (y[o - j] - y[o - j - 1]) / dt,
-                dt,
-            )
-        };
-        let legs: Vec<(f64, f64, f64)> = (0..p.lags).map(vel).collect();
-        let u = Heading::of(&legs.iter().map(|&(a, b, _)| (a, b)).collect::<Vec<_>>());
-        let rot = |a: f64, b: f64| u.rotate((a, b));
-        let first = o + 1 - p.window.min(o + 1);
-        let span = t[o] - t[first];
-        let delta = span / (o - first) as f64;
-        let v0 = rot(legs[0].0, legs[0].1);
-        let mut feats = Vec::with_capacity(p.features());
-        feats.extend([v0.0.hypot(v0.1), delta]);
-        for &(a, b, dt) in &legs {
-            let (ra, rb) = rot(a, b);
-            feats.extend([ra, rb, dt]);
-        }
-        let mean = rot((x[o] - x[first]) / span, (y[o] - y[first]) / span);
-        feats.extend([mean.0, mean.1]);
-        if p.shape_features {
-            shape_features(&t[first..=o], &x[first..=o], &y[first..=o], u, &mut feats);
-        }
-        Origin {
-            u,
-            v0,
-            delta,
-            feats,
-        }
-    }
-
-    /// Rotates an aligned displacement back to the data's axes.
-    fn unrotate(&self, d: (f64, f64)) -> (f64, f64) {
-        self.u.unrotate(d)
-    }
-}
-
-/// The coefficients of the least-squares polynomial of degree 1 or 2 through `(t_i, v_i)`
-/// with `t` relative to the last time (so the first is the value at the origin), lowest
-/// degree first; zeros when there are fewer points than coefficients. The times must be
-/// distinct (a track's are increasing).
-fn poly_fit<const D: usize>(t: &[f64], v: &[f64]) -> [f64; D] {
-    if t.len() < D {
-        return [0.0; D];
-    }
-    let t0 = t[t.len() - 1];
-    let mut m = [[0.0; D]; D];
-    let mut r = [0.0; D];
-    for (&ti, &vi) in t.iter().zip(v) {
-        let s = ti - t0;
-        let pw = [1.0, s, s * s];
-        for a in 0..D {
-            r[a] += pw[a] * vi;
-            for b in 0..D {
-                m[a][b] += pw[a] * pw[b];
-            }
-        }
-    }
-    // Gaussian elimination without pivoting: the moment matrix is positive definite
-    // when there are at least as many distinct times as coefficients
-    for c in 0..D {
-        let pivot = m[c];
-        for row in c + 1..D {
-            let f = m[row][c] / pivot[c];
-            for (mk, pk) in m[row].iter_mut().zip(pivot).skip(c) {
-                *mk -= f * pk;
-            }
-            r[row] -= f * r[c];
-        }
-    }
-    let mut out = [0.0; D];
-    for c in (0..D).rev() {
-        let tail: f64 = (c + 1..D).map(|k| m[c][k] * out[k]).sum();
-        out[c] = (r[c] - tail) / m[c][c];
-    }
-    out
-}
-
-/// The shape features of a window (`t`, `x`, `y` from its first point to the origin), in
-/// the frame `u`: see [`AlignedGbmParams::shape_features`].
-fn shape_features(t: &[f64], x: &[f64], y: &[f64], u: Heading, feats: &mut Vec<f64>) {
-    let n = t.len();
-    let (x0, y0) = (x[n - 1], y[n - 1]);
-    let rel = |v: &[f64], at: f64| v.iter().map(|a| a - at).collect::<Vec<f64>>();
-    let (xr, yr) = (rel(x, x0), rel(y, y0));
-    for k in [5, 10, n] {
-        let k = k.min(n);
-        let from = n - k;
-        let fx = poly_fit::<2>(&t[from..], &xr[from..]);
-        let fy = poly_fit::<2>(&t[from..], &yr[from..]);
-        for d in 0..2 {
-            let (a, b) = u.rotate((fx[d], fy[d]));
-            feats.extend([a, b]);
-        }
-    }
-    let from = n - 10.min(n);
-    let fx = poly_fit::<3>(&t[from..], &xr[from..]);
-    let fy = poly_fit::<3>(&t[from..], &yr[from..]);
-    for d in 0..3 {
-        let (a, b) = u.rotate((fx[d], fy[d]));
-        feats.extend([a, b]);
-    }
-    let legs: Vec<(f64, f64, f64)> = (1..n)
-        .map(|i| {
-            let dt = t[i] - t[i - 1];
-            let (a, b) = u.rotate(((x[i] - x[i - 1]) / dt, (y[i] - y[i - 1]) / dt));
-            (a.hypot(b), b.atan2(a), dt)
-        })
-        .collect();
-    let mean_sd = |v: &[f64]| {
-        let m = v.iter().sum::<f64>() / v.len() as f64;
-        (v.iter().map(|a| (a - m) * (a - m)).sum::<f64>() / v.len() as f64).sqrt()
-    };
-    let mut speeds: Vec<f64> = legs.iter().map(|l| l.0).collect();
-    let dts: Vec<f64> = legs.iter().map(|l| l.2).collect();
-    let speed_sd = mean_sd(&speeds);
-    speeds.sort_by(f64::total_cmp);
-    let slow = speeds.iter().filter(|&&v| v < 0.3).count() as f64;
-    let turn: f64 = legs
-        .windows(2)
-        .map(|w| {
-            let d = w[1].1 - w[0].1;
-            (d + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI
-        })
-        .map(f64::abs)
-        .sum();
-    feats.extend([
-        speed_sd,
-        speeds[speeds.len() - 1],
-        speeds[0],
-        speeds[speeds.len() / 2],
-        slow,
-        mean_sd(&dts),
-        dts.iter().copied().fold(0.0, f64::max),
-        turn,
-    ]);
 }
 
 /// Training samples of one step: features row by row, and the two normalised targets.
@@ -335,7 +168,7 @@ fn samples(p: &AlignedGbmParams, tr: &Trajectory, s: usize, into: &mut Samples) 
     let t = tr.times();
     let (x, y) = xy(tr);
     for o in p.lags..tr.len().saturating_sub(s) {
-        let org = Origin::new(p, t, x, &y, o);
+        let org = Origin::new(&p.layout(), t, x, &y, o);
         let tau = t[o + s] - t[o];
         let d = (x[o + s] - x[o], y[o + s] - y[o]);
         let r = org.u.rotate(d);
@@ -491,7 +324,7 @@ impl AlignedGbm {
             (0..n).collect()
         };
         let copies: &[f64] = if p.mirror { &[1.0, -1.0] } else { &[1.0] };
-        let signs = p.mirror_signs();
+        let signs = p.layout().mirror_signs();
         let mut data = Vec::with_capacity(copies.len() * keep.len() * p.features());
         for (j, sign) in signs.iter().enumerate() {
             for c in copies {
@@ -594,7 +427,7 @@ impl Predictor for AlignedGbm {
         let n = history.len();
         let t = history.times();
         let (x, y) = xy(history);
-        let org = Origin::new(&self.params, t, x, &y, n - 1);
+        let org = Origin::new(&self.params.layout(), t, x, &y, n - 1);
         let steps: Vec<Vec<f64>> = times
             .iter()
             .zip(&self.models)
@@ -695,64 +528,5 @@ impl Predictor for AlignedGbm {
             trees.join(", "),
             self.samples
         ))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::{AlignedGbmParams, Origin, poly_fit};
-
-    #[test]
-    fn every_feature_is_the_same_for_a_turned_and_moved_history() {
-        // the features are taken in the frame of the last velocity: turning and moving the
-        // window must leave every one of them as it was
-        let t: Vec<f64> = (0..25)
-            .map(|i| i as f64 * 1.5 + 0.4 * ((i * 5) % 3) as f64)
-            .collect();
-        let x: Vec<f64> = t.iter().map(|t| 8.0 * t - 0.05 * t * t).collect();
-        let y: Vec<f64> = t.iter().map(|t| 3.0 * (0.2 * t).sin() * t).collect();
-        let (c, s) = (0.7_f64.cos(), 0.7_f64.sin());
-        let tx: Vec<f64> = x
-            .iter()
-            .zip(&y)
-            .map(|(a, b)| c * a - s * b + 300.0)
-            .collect();
-        let ty: Vec<f64> = x
-            .iter()
-            .zip(&y)
-            .map(|(a, b)| s * a + c * b - 120.0)
-            .collect();
-        let p = AlignedGbmParams::default();
-        let (a, b) = (
-            Origin::new(&p, &t, &x, &y, 24),
-            Origin::new(&p, &t, &tx, &ty, 24),
-        );
-        assert_eq!(a.feats.len(), p.features());
-        for (i, (u, v)) in a.feats.iter().zip(&b.feats).enumerate() {
-            assert!(
-                (u - v).abs() < 1e-9 * (1.0 + u.abs()),
-                "feature {i}: {u} against {v}"
-            );
-        }
-    }
-
-    #[test]
-    fn poly_fit_recovers_a_parabola_and_a_line_at_the_last_time() {
-        let t = [10.0, 11.5, 12.0, 13.7, 15.0, 16.2];
-        // v = 3 + 2 s - 0.5 s^2 with s = t - 16.2
-        let v: Vec<f64> = t
-            .iter()
-            .map(|&t| {
-                let s = t - 16.2;
-                3.0 + 2.0 * s - 0.5 * s * s
-            })
-            .collect();
-        let [a, b, c] = poly_fit::<3>(&t, &v);
-        assert!((a - 3.0).abs() < 1e-9 && (b - 2.0).abs() < 1e-9 && (c + 0.5).abs() < 1e-9);
-        // the least-squares line through (0, 0), (1, 1), (2, 0), by hand: v = 1/3 at every
-        // time, so 1/3 at the last time and slope 0
-        let [a, b] = poly_fit::<2>(&[0.0, 1.0, 2.0], &[0.0, 1.0, 0.0]);
-        assert!((a - 1.0 / 3.0).abs() < 1e-12 && b.abs() < 1e-12, "{a} {b}");
-        assert_eq!(poly_fit::<3>(&[0.0, 1.0], &[1.0, 2.0]), [0.0; 3]);
     }
 }

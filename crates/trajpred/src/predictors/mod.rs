@@ -1,5 +1,6 @@
 //! Every method of the four papers as a [`Predictor`](trajpred_core::Predictor).
 
+mod aligned_features;
 mod aligned_gbm;
 mod aligned_ridge;
 mod auto;
