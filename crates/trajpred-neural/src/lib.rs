@@ -26,6 +26,7 @@ pub mod error;
 mod fused;
 pub mod kfu;
 mod persist;
+pub mod tabular;
 mod train;
 pub mod window;
 
@@ -37,5 +38,6 @@ pub use config::{
 };
 pub use error::{NeuralError, Result};
 pub use kfu::{KfuCell, KfuConfig, KfuLstmNet, Noise, kalman_update};
+pub use tabular::{Dense, DistanceMlp, DistanceMlpConfig, PlanarRows};
 pub use train::Standardizer;
 pub use window::{LstmNet, Mlp, RnnNet, WindowConfig, WindowNet};
