@@ -7,14 +7,15 @@
 //! cargo run --release -p trajpred --example tune_by_user -- geolife ../shared/data/geolife 5 55
 //! ```
 //! (dataset, path, `--max-gap`, `--min-points`; a fifth argument `gbm` scores
-//! `aligned-gbm`'s variants instead, with a sixth `1` to `5` for the first to fifth round
+//! `aligned-gbm`'s variants instead, with a sixth `1` to `9` for the first to ninth round
 //! of them; the split is `--split by-user`,
 //! `--train-fraction 0.3`, `--seed 0`, the evaluation `--history 20 --horizon 5`.)
 
 use trajpred::dataset::{Dataset, Segmentation, load};
 use trajpred::harness::{EvalConfig, Split, group_ids, split_segments};
 use trajpred::predictors::{
-    AlignedGbm, AlignedGbmParams, AlignedRidge, AlignedRidgeParams, cross_validate,
+    AlignedGbm, AlignedGbmParams, AlignedMlp, AlignedMlpParams, AlignedRidge, AlignedRidgeParams,
+    cross_validate,
 };
 use trajpred::registry::{MethodOptions, build};
 use trajpred_core::{Predictor, Result, Trajectory};
@@ -128,6 +129,62 @@ fn main() -> Result<()> {
                     ..Default::default()
                 },
             )?;
+        } else if arg(6, "1") == "6" {
+            let origins: usize = tracks.iter().map(|t| t.len().saturating_sub(9)).sum();
+            eprintln!("training origins at step 1 (8 lags): {origins}");
+            gbm(
+                "gbm every origin (no cap)",
+                AlignedGbmParams {
+                    max_samples: usize::MAX,
+                    ..Default::default()
+                },
+            )?;
+            gbm(
+                "gbm at most 50,000 origins a step",
+                AlignedGbmParams {
+                    max_samples: 50_000,
+                    ..Default::default()
+                },
+            )?;
+        } else if arg(6, "1") == "7" {
+            gbm(
+                "gbm every origin, mirrored, 2 reweighted passes",
+                AlignedGbmParams {
+                    max_samples: usize::MAX,
+                    mirror: true,
+                    robust_passes: 2,
+                    ..Default::default()
+                },
+            )?;
+        } else if arg(6, "1") == "8" {
+            report("aligned-mlp", &|| build("aligned-mlp", &opts))?;
+            let mlp = |name: &str, p: AlignedMlpParams| -> Result<()> {
+                report(name, &|| {
+                    Ok(Box::new(AlignedMlp::new(p.clone())?) as Box<dyn Predictor>)
+                })
+            };
+            let mut p = AlignedMlpParams::default();
+            p.network.epochs = 40;
+            mlp("aligned-mlp 40 epochs", p)?;
+            let mut p = AlignedMlpParams::default();
+            p.network.hidden = vec![512, 512];
+            mlp("aligned-mlp 2 x 512", p)?;
+        } else if arg(6, "1") == "9" {
+            let mlp = |name: &str, p: AlignedMlpParams| -> Result<()> {
+                report(name, &|| {
+                    Ok(Box::new(AlignedMlp::new(p.clone())?) as Box<dyn Predictor>)
+                })
+            };
+            let mut p = AlignedMlpParams::default();
+            p.network.epochs = 10;
+            mlp("aligned-mlp 10 epochs", p)?;
+            for members in [2, 4] {
+                let p = AlignedMlpParams {
+                    members,
+                    ..Default::default()
+                };
+                mlp(&format!("aligned-mlp {members} members"), p)?;
+            }
         } else if arg(6, "1") == "1" {
             gbm(
                 "gbm 100 rounds",

@@ -139,6 +139,11 @@ pub const METHODS: &[MethodInfo] = &[
         name: "aligned-gbm",
         description: "last velocity corrected by gradient-boosted trees in the heading-aligned frame",
     },
+    #[cfg(feature = "neural")]
+    MethodInfo {
+        name: "aligned-mlp",
+        description: "last velocity corrected by a neural network in the heading-aligned frame, fitted to the mean distance",
+    },
     MethodInfo {
         name: "auto",
         description: "the candidate with the lowest cross-validated error by user on the training part (see predictors::Auto)",
@@ -292,6 +297,17 @@ pub fn build(name: &str, opts: &MethodOptions) -> Result<Box<dyn Predictor>> {
             horizons: opts.horizons,
             ..Default::default()
         })?),
+        #[cfg(feature = "neural")]
+        "aligned-mlp" => Box::new(crate::predictors::AlignedMlp::new(
+            crate::predictors::AlignedMlpParams {
+                horizons: opts.horizons,
+                network: trajpred_neural::DistanceMlpConfig {
+                    seed: opts.seed,
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+        )?),
         "auto" => Box::new(Auto::new(
             AutoParams {
                 seed: opts.seed,

@@ -12,7 +12,7 @@ use trajpred::protocol::{self, MethodSpec, Protocol, Silent};
 use trajpred::registry::{MethodOptions, build};
 use trajpred_core::{Error, Forecast, Predictor, Trajectory};
 
-/// Every non-neural method: the learners and those that learn nothing.
+/// Every method but the papers' networks: the learners and those that learn nothing.
 const METHODS: &[&str] = &[
     "kf-cv",
     "kf-ca",
@@ -29,6 +29,7 @@ const METHODS: &[&str] = &[
     "mkpf",
     "aligned-ridge",
     "aligned-gbm",
+    "aligned-mlp",
     "auto",
     "blend",
     "last-position",
@@ -148,6 +149,7 @@ fn loaded_parameters_forecast_bit_for_bit_as_the_fitted_methods() {
                 "imm",
                 "aligned-ridge",
                 "aligned-gbm",
+                "aligned-mlp",
                 "auto",
                 "blend",
                 "pf",

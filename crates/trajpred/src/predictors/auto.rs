@@ -11,7 +11,9 @@ use std::fmt::Write as _;
 use trajpred_core::{Error, Forecast, Predictor, Result, Trajectory};
 
 /// The candidates `auto` chooses from by default: every registered method that fits in
-/// seconds (`aligned-gbm`: tens of seconds on GeoLife's training users) and needs no extra file (the particle filters and the networks are left out for
+/// seconds (`aligned-gbm`: tens of seconds on GeoLife's training users; `aligned-mlp`, with
+/// the `neural` feature, about 20 s) and needs no extra file (the particle filters and the
+/// papers' networks are left out for
 /// their run time, `kf-dynamic` and the 4-D variants for being equal to `naive-kf` or close
 /// to it).
 pub const DEFAULT_CANDIDATES: &[&str] = &[
@@ -25,6 +27,8 @@ pub const DEFAULT_CANDIDATES: &[&str] = &[
     "hmm",
     "aligned-ridge",
     "aligned-gbm",
+    #[cfg(feature = "neural")]
+    "aligned-mlp",
 ];
 
 /// Parameters of [`Auto`].

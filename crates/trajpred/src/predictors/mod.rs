@@ -2,6 +2,8 @@
 
 mod aligned_features;
 mod aligned_gbm;
+#[cfg(feature = "neural")]
+mod aligned_mlp;
 mod aligned_ridge;
 mod auto;
 mod blend;
@@ -18,6 +20,8 @@ mod poly;
 mod trees;
 
 pub use aligned_gbm::{AlignedGbm, AlignedGbmParams};
+#[cfg(feature = "neural")]
+pub use aligned_mlp::{AlignedMlp, AlignedMlpParams};
 pub use aligned_ridge::{AlignedRidge, AlignedRidgeParams};
 pub use auto::{Auto, AutoParams, CandidateScore, DEFAULT_CANDIDATES, cross_validate};
 pub use blend::{Blend, BlendParams};
