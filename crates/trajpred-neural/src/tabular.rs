@@ -469,6 +469,17 @@ mod tests {
         (x, y, s)
     }
 
+    /// Rows of two features with one planar target each.
+    fn two<'a>(x: &'a [f64], y: &'a [f64], s: &'a [f64]) -> PlanarRows<'a> {
+        PlanarRows {
+            features: 2,
+            rows: x,
+            pairs: 1,
+            targets: y,
+            scales: s,
+        }
+    }
+
     fn cfg() -> DistanceMlpConfig {
         DistanceMlpConfig {
             hidden: vec![32, 32],
@@ -481,13 +492,7 @@ mod tests {
     #[test]
     fn it_learns_a_scaled_planar_function_and_the_same_seed_gives_the_same_weights() {
         let (x, y, s) = toy(3000);
-        let rows = PlanarRows {
-            features: 2,
-            rows: &x,
-            pairs: 1,
-            targets: &y,
-            scales: &s,
-        };
+        let rows = two(&x, &y, &s);
         let a = DistanceMlp::fit(&cfg(), rows).unwrap();
         let b = DistanceMlp::fit(&cfg(), rows).unwrap();
         assert_eq!(a, b);
@@ -507,13 +512,7 @@ mod tests {
     #[test]
     fn a_network_rebuilt_from_its_parts_is_the_same_and_damaged_parts_are_refused() {
         let (x, y, s) = toy(200);
-        let rows = PlanarRows {
-            features: 2,
-            rows: &x,
-            pairs: 1,
-            targets: &y,
-            scales: &s,
-        };
+        let rows = two(&x, &y, &s);
         let m = DistanceMlp::fit(&DistanceMlpConfig { epochs: 2, ..cfg() }, rows).unwrap();
         let parts = || {
             (
@@ -539,13 +538,7 @@ mod tests {
     #[test]
     fn bad_rows_are_typed_errors() {
         let (x, y, s) = toy(10);
-        let ok = PlanarRows {
-            features: 2,
-            rows: &x,
-            pairs: 1,
-            targets: &y,
-            scales: &s,
-        };
+        let ok = two(&x, &y, &s);
         let short = PlanarRows {
             targets: &y[..19],
             ..ok
@@ -594,13 +587,7 @@ mod tests {
     #[test]
     fn a_prediction_checks_its_row() {
         let (x, y, s) = toy(200);
-        let rows = PlanarRows {
-            features: 2,
-            rows: &x,
-            pairs: 1,
-            targets: &y,
-            scales: &s,
-        };
+        let rows = two(&x, &y, &s);
         let m = DistanceMlp::fit(&DistanceMlpConfig { epochs: 1, ..cfg() }, rows).unwrap();
         assert!(matches!(
             m.predict(&[1.0]),

@@ -1,7 +1,10 @@
 //! The description of a window that `aligned-gbm` and `aligned-mlp` learn from: every
 //! feature in the frame where the window's last velocity points along +x (issue 27).
 
-use super::Heading;
+use super::fitted::At;
+use super::{Heading, horizontal_axes as xy};
+use serde_json::Value;
+use trajpred_core::{Forecast, Result, Trajectory};
 
 /// Which features a window is described by.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -201,6 +204,91 @@ fn shape_features(t: &[f64], x: &[f64], y: &[f64], u: Heading, feats: &mut Vec<f
         dts.iter().copied().fold(0.0, f64::max),
         turn,
     ]);
+}
+
+/// The forecast of an aligned learner at `times` (checked by the caller): with `c` the
+/// corrections its model gives the history's last origin, one per step (per unit of the
+/// time ahead on the window's grid), the displacement `tau` seconds ahead at step `s` is
+/// `R' [tau v0' + (tau / (s delta)) c_s]`; a third axis follows its last velocity.
+pub(super) fn forecast_at(
+    layout: &Layout,
+    history: &Trajectory,
+    times: &[f64],
+    corrections: impl FnOnce(&Origin) -> Result<Vec<(f64, f64)>>,
+) -> Result<Forecast> {
+    let n = history.len();
+    let t = history.times();
+    let (x, y) = xy(history);
+    let org = Origin::new(layout, t, x, &y, n - 1);
+    let c = corrections(&org)?;
+    let steps: Vec<Vec<f64>> = times
+        .iter()
+        .zip(c)
+        .enumerate()
+        .map(|(i, (&at, (ca, cb)))| {
+            let tau = at - t[n - 1];
+            let scale = tau / ((i + 1) as f64 * org.delta);
+            let d = org.unrotate((tau * org.v0.0 + scale * ca, tau * org.v0.1 + scale * cb));
+            super::displaced_point(history, d, tau)
+        })
+        .collect();
+    Forecast::new(history.dim(), steps)
+}
+
+/// `horizon` forecast times after the history's end, spaced by the mean interval of its
+/// last `window` points (what `forecast` asks an aligned learner for).
+pub(super) fn grid_times(history: &Trajectory, window: usize, horizon: usize) -> Vec<f64> {
+    let n = history.len();
+    let delta = super::step_interval(history, window.min(n));
+    let last = history.times()[n - 1];
+    (1..=horizon).map(|k| last + k as f64 * delta).collect()
+}
+
+impl Layout {
+    /// A fitted model's parameters: these settings (`lags`, `window`, `shape_features`), the
+    /// `horizons` and the model under `key`.
+    pub(super) fn saved(&self, horizons: usize, key: &str, model: Value) -> Value {
+        let mut v = serde_json::json!({
+            "lags": self.lags,
+            "window": self.window,
+            "horizons": horizons,
+            "shape_features": self.shape,
+        });
+        v[key] = model;
+        v
+    }
+
+    /// Reads parameters written by [`Layout::saved`]: checks the settings against these and
+    /// `horizons` (naming the one that differs) and returns the model under `key`.
+    pub(super) fn read_saved<'a>(
+        &self,
+        horizons: usize,
+        root: &At<'a>,
+        key: &str,
+    ) -> Result<At<'a>> {
+        let [lags, window, horizons_at, shape, model] =
+            root.fields(["lags", "window", "horizons", "shape_features", key])?;
+        let saved_shape = shape.bool()?;
+        if saved_shape != self.shape {
+            return Err(shape.error(format!(
+                "fitted with shape_features {saved_shape}, but this predictor has {}",
+                self.shape
+            )));
+        }
+        for (at, ours, key) in [
+            (&lags, self.lags, "lags"),
+            (&window, self.window, "window"),
+            (&horizons_at, horizons, "horizons"),
+        ] {
+            let saved = at.f64()?;
+            if saved != ours as f64 {
+                return Err(at.error(format!(
+                    "fitted with {key} {saved}, but this predictor has {key} {ours}"
+                )));
+            }
+        }
+        Ok(model)
+    }
 }
 
 #[cfg(test)]

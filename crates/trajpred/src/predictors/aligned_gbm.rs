@@ -1,7 +1,7 @@
 //! `aligned-gbm`: gradient-boosted trees that correct the last velocity, learned in the
 //! heading-aligned frame of `aligned-ridge` (issue 27).
 
-use super::aligned_features::{Layout, Origin};
+use super::aligned_features::{Layout, Origin, forecast_at, grid_times};
 use super::fitted::At;
 use super::trees::Ensemble;
 use super::{horizontal_axes as xy, invalid};
@@ -409,11 +409,7 @@ impl Predictor for AlignedGbm {
 
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
         check_forecast_args(history, horizon, self.min_history())?;
-        let n = history.len();
-        let delta = super::step_interval(history, self.params.window.min(n));
-        let last = history.times()[n - 1];
-        let times: Vec<f64> = (1..=horizon).map(|k| last + k as f64 * delta).collect();
-        self.forecast_times(history, &times)
+        self.forecast_times(history, &grid_times(history, self.params.window, horizon))
     }
 
     fn forecast_times(&self, history: &Trajectory, times: &[f64]) -> Result<Forecast> {
@@ -424,24 +420,14 @@ impl Predictor for AlignedGbm {
             });
         }
         super::check_fitted_times(NAME, self.models.len(), history, times)?;
-        let n = history.len();
-        let t = history.times();
-        let (x, y) = xy(history);
-        let org = Origin::new(&self.params.layout(), t, x, &y, n - 1);
-        let steps: Vec<Vec<f64>> = times
-            .iter()
-            .zip(&self.models)
-            .enumerate()
-            .map(|(i, (&at, [along, across]))| {
-                let tau = at - t[n - 1];
-                let scale = tau / ((i + 1) as f64 * org.delta);
-                let c = (along.predict(&org.feats), across.predict(&org.feats));
-                let (dx, dy) =
-                    org.unrotate((tau * org.v0.0 + scale * c.0, tau * org.v0.1 + scale * c.1));
-                super::displaced_point(history, (dx, dy), tau)
-            })
-            .collect();
-        Forecast::new(history.dim(), steps)
+        forecast_at(&self.params.layout(), history, times, |org| {
+            Ok(self
+                .models
+                .iter()
+                .take(times.len())
+                .map(|[along, across]| (along.predict(&org.feats), across.predict(&org.feats)))
+                .collect())
+        })
     }
 
     fn min_history(&self) -> usize {
@@ -463,39 +449,13 @@ impl Predictor for AlignedGbm {
             .map(|[a, b]| serde_json::json!([a.to_json(), b.to_json()]))
             .collect();
         let p = &self.params;
-        Ok(serde_json::json!({
-            "lags": p.lags,
-            "window": p.window,
-            "horizons": p.horizons,
-            "shape_features": p.shape_features,
-            "models": models,
-        }))
+        Ok(p.layout().saved(p.horizons, "models", models.into()))
     }
 
     fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
         let root = At::root(NAME, params);
-        let [lags, window, horizons, shape, models] =
-            root.fields(["lags", "window", "horizons", "shape_features", "models"])?;
         let p = &self.params;
-        let saved_shape = shape.bool()?;
-        if saved_shape != p.shape_features {
-            return Err(shape.error(format!(
-                "fitted with shape_features {saved_shape}, but this predictor has {}",
-                p.shape_features
-            )));
-        }
-        for (at, ours, key) in [
-            (&lags, p.lags, "lags"),
-            (&window, p.window, "window"),
-            (&horizons, p.horizons, "horizons"),
-        ] {
-            let saved = at.f64()?;
-            if saved != ours as f64 {
-                return Err(at.error(format!(
-                    "fitted with {key} {saved}, but this predictor has {key} {ours}"
-                )));
-            }
-        }
+        let models = p.layout().read_saved(p.horizons, &root, "models")?;
         let max_trees = 1 << 20;
         let models = models
             .items(Some(p.horizons), p.horizons)?

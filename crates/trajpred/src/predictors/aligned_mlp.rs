@@ -1,7 +1,7 @@
 //! `aligned-mlp`: a network that corrects the last velocity, learned in the heading-aligned
 //! frame of `aligned-gbm` from the same features, fitted to the mean distance (issue 27).
 
-use super::aligned_features::{Layout, Origin};
+use super::aligned_features::{Layout, Origin, forecast_at, grid_times};
 use super::fitted::{At, exact_vec};
 use super::{horizontal_axes as xy, invalid};
 use rayon::prelude::*;
@@ -241,11 +241,7 @@ impl Predictor for AlignedMlp {
 
     fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<Forecast> {
         check_forecast_args(history, horizon, self.min_history())?;
-        let n = history.len();
-        let delta = super::step_interval(history, self.params.window.min(n));
-        let last = history.times()[n - 1];
-        let times: Vec<f64> = (1..=horizon).map(|k| last + k as f64 * delta).collect();
-        self.forecast_times(history, &times)
+        self.forecast_times(history, &grid_times(history, self.params.window, horizon))
     }
 
     fn forecast_times(&self, history: &Trajectory, times: &[f64]) -> Result<Forecast> {
@@ -256,31 +252,20 @@ impl Predictor for AlignedMlp {
             });
         }
         super::check_fitted_times(NAME, self.params.horizons, history, times)?;
-        let n = history.len();
-        let t = history.times();
-        let (x, y) = xy(history);
-        let org = Origin::new(&self.params.layout(), t, x, &y, n - 1);
-        let mut c = vec![0.0; 2 * self.params.horizons];
-        for m in &self.model {
-            let out = m
-                .predict(&org.feats)
-                .map_err(|e| Error::from_crate(NAME.to_string(), e))?;
-            for (a, b) in c.iter_mut().zip(out) {
-                *a += b / self.model.len() as f64;
+        forecast_at(&self.params.layout(), history, times, |org| {
+            let mut c = vec![(0.0, 0.0); self.params.horizons];
+            let share = 1.0 / self.model.len() as f64;
+            for m in &self.model {
+                let out = m
+                    .predict(&org.feats)
+                    .map_err(|e| Error::from_crate(NAME.to_string(), e))?;
+                for (ci, o) in c.iter_mut().zip(out.chunks_exact(2)) {
+                    ci.0 += share * o[0];
+                    ci.1 += share * o[1];
+                }
             }
-        }
-        let steps: Vec<Vec<f64>> = times
-            .iter()
-            .enumerate()
-            .map(|(i, &at)| {
-                let tau = at - t[n - 1];
-                let scale = tau / ((i + 1) as f64 * org.delta);
-                let (ca, cb) = (c[2 * i], c[2 * i + 1]);
-                let d = org.unrotate((tau * org.v0.0 + scale * ca, tau * org.v0.1 + scale * cb));
-                super::displaced_point(history, d, tau)
-            })
-            .collect();
-        Forecast::new(history.dim(), steps)
+            Ok(c)
+        })
     }
 
     fn min_history(&self) -> usize {
@@ -320,39 +305,13 @@ impl Predictor for AlignedMlp {
                 })
             })
             .collect();
-        Ok(serde_json::json!({
-            "lags": p.lags,
-            "window": p.window,
-            "horizons": p.horizons,
-            "shape_features": p.shape_features,
-            "networks": networks,
-        }))
+        Ok(p.layout().saved(p.horizons, "networks", networks.into()))
     }
 
     fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
         let root = At::root(NAME, params);
-        let [lags, window, horizons, shape, networks] =
-            root.fields(["lags", "window", "horizons", "shape_features", "networks"])?;
         let p = &self.params;
-        let saved_shape = shape.bool()?;
-        if saved_shape != p.shape_features {
-            return Err(shape.error(format!(
-                "fitted with shape_features {saved_shape}, but this predictor has {}",
-                p.shape_features
-            )));
-        }
-        for (at, ours, key) in [
-            (&lags, p.lags, "lags"),
-            (&window, p.window, "window"),
-            (&horizons, p.horizons, "horizons"),
-        ] {
-            let saved = at.f64()?;
-            if saved != ours as f64 {
-                return Err(at.error(format!(
-                    "fitted with {key} {saved}, but this predictor has {key} {ours}"
-                )));
-            }
-        }
+        let networks = p.layout().read_saved(p.horizons, &root, "networks")?;
         let (f, h) = (p.layout().count(), p.horizons);
         let model = networks
             .items(None, 1 << 10)?
