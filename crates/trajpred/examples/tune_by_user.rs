@@ -7,7 +7,7 @@
 //! cargo run --release -p trajpred --example tune_by_user -- geolife ../shared/data/geolife 5 55
 //! ```
 //! (dataset, path, `--max-gap`, `--min-points`; a fifth argument `gbm` scores
-//! `aligned-gbm`'s variants instead, with a sixth `1` to `9` for the first to ninth round
+//! `aligned-gbm`'s variants instead, with a sixth `1` to `10` for the first to tenth round
 //! of them; the split is `--split by-user`,
 //! `--train-fraction 0.3`, `--seed 0`, the evaluation `--history 20 --horizon 5`.)
 
@@ -185,6 +185,32 @@ fn main() -> Result<()> {
                 };
                 mlp(&format!("aligned-mlp {members} members"), p)?;
             }
+        } else if arg(6, "1") == "10" {
+            let one = |f: &dyn Fn(&mut AlignedMlpParams)| {
+                let mut p = AlignedMlpParams {
+                    members: 1,
+                    ..Default::default()
+                };
+                f(&mut p);
+                p
+            };
+            let mlp = |name: &str, p: AlignedMlpParams| -> Result<()> {
+                report(name, &|| {
+                    Ok(Box::new(AlignedMlp::new(p.clone())?) as Box<dyn Predictor>)
+                })
+            };
+            mlp(
+                "aligned-mlp one network, learning rate 1e-2",
+                one(&|p| p.network.learning_rate = 1e-2),
+            )?;
+            mlp(
+                "aligned-mlp one network, batches of 256",
+                one(&|p| p.network.batch_size = 256),
+            )?;
+            mlp(
+                "aligned-mlp one network, three hidden layers of 256",
+                one(&|p| p.network.hidden = vec![256, 256, 256]),
+            )?;
         } else if arg(6, "1") == "1" {
             gbm(
                 "gbm 100 rounds",
