@@ -423,6 +423,7 @@ fn correction_case(series: &[Vec<f64>]) -> (Vec<Trajectory>, GskfParams, Vec<(f6
         choose_steps: false,
         relative: false,
         choose_frame: false,
+        gain_lags: vec![],
     };
     let by_hand = held_out_errors_by_hand(series, &tracks, &params, 1.0);
     (tracks, params, by_hand)

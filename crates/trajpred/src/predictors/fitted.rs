@@ -91,6 +91,16 @@ impl<'a> At<'a> {
             .map_err(|_| self.error("internal: field count"))
     }
 
+    /// The field `key` when the object has it (allow it with
+    /// [`fields_and`](Self::fields_and)'s `optional`).
+    pub(crate) fn optional(&self, key: &str) -> Option<At<'a>> {
+        self.value.get(key).map(|value| At {
+            value,
+            path: self.child(key),
+            method: self.method,
+        })
+    }
+
     fn child(&self, key: &str) -> String {
         if self.path.is_empty() {
             key.to_string()

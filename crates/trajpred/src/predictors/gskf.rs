@@ -19,12 +19,15 @@ use std::fmt::Write as _;
 use trajpred_core::{
     Error, Forecast, Gaussian, Predictor, Result, Trajectory, check_forecast_args,
 };
-use trajpred_kalman::{Ikf, Innovation, LinearObservation, LinearTransition};
 use trajpred_sparse::{GroupSparseCoder, Lars};
 
+mod axis;
 mod correct;
 mod diverged;
+mod gain;
 mod steps;
+
+use axis::{AxisFilter, errors, in_sample_error};
 
 pub use diverged::Diverged;
 
@@ -59,6 +62,15 @@ pub struct GskfParams {
     /// `docs/gskf.md`); parameters saved before it read back as `false`.
     #[serde(default)]
     pub choose_frame: bool,
+    /// When `q` is `None`: the residual lags of the gains fitted to the training series that
+    /// are tried beside the IKF's (a gain fitted by least squares on the residual vectors of
+    /// the `lags + 1` most recent origins; see `docs/gskf.md`). Chosen on held-out groups with
+    /// several groups, else on the last quarter of the training origins against the IKF with
+    /// the `q` chosen in sample. Empty: the paper's IKF only. Default `[0, 1, 2]` (since
+    /// 2026-12-07); parameters saved before it read back as empty. Each at most 64; a history
+    /// needs `window + horizons + max(gain_lags)` points.
+    #[serde(default)]
+    pub gain_lags: Vec<usize>,
 }
 
 impl Default for GskfParams {
@@ -71,6 +83,7 @@ impl Default for GskfParams {
             choose_steps: true,
             relative: false,
             choose_frame: true,
+            gain_lags: vec![0, 1, 2],
         }
     }
 }
@@ -89,6 +102,12 @@ impl GskfParams {
             return Err(invalid(
                 "q",
                 format!("must be finite and non-negative, got {q}"),
+            ));
+        }
+        if let Some(&l) = self.gain_lags.iter().find(|&&l| l > gain::MAX_LAGS) {
+            return Err(invalid(
+                "gain_lags",
+                format!("each must be at most {}, got {l}", gain::MAX_LAGS),
             ));
         }
         if self.q.is_none()
@@ -153,168 +172,6 @@ fn residuals(gsc: &GroupSparseCoder, x: &[f64], i: usize) -> Result<DVector<f64>
     Ok(v)
 }
 
-/// One axis of a fitted GSKF: the GSC, the IKF and its converged covariances.
-#[derive(Debug, Clone)]
-struct AxisFilter {
-    gsc: GroupSparseCoder,
-    ikf: Ikf<LinearTransition<f64, Dyn>, LinearObservation<f64, Dyn, Dyn>>,
-    /// `P(k|k-1)` at convergence.
-    p_prior: DMatrix<f64>,
-    /// `S(k-1) = P(k-1|k-2) + R` at convergence.
-    s: DMatrix<f64>,
-    /// The process noise level, `Q = q I`.
-    q: f64,
-    /// Whether the Kalman correction is applied; without it the forecast is the GSC's, with
-    /// `R` as its covariance (chosen when no `q` beats the GSC on held-out groups).
-    correct: bool,
-}
-
-impl AxisFilter {
-    /// Builds the IKF for `q` and runs its covariance recursion, which does not depend on the
-    /// data (F, Q, R are fixed), to convergence.
-    fn new(gsc: GroupSparseCoder, q: f64) -> Result<Self> {
-        let (m, t) = (gsc.window(), gsc.horizons());
-        // F: the T predicted rows and columns of the m x m matrix of eq. 17-19 (for T <= m,
-        // the last T columns of A); identity when T > m (`docs/papers.md` A.4)
-        let f = if t <= m {
-            gsc.coefficients().columns(m - t, t).into_owned()
-        } else {
-            DMatrix::identity(t, t)
-        };
-        let r_diag: Vec<f64> = gsc
-            .residual_variances()
-            .iter()
-            .map(|v| v.max(1e-300))
-            .collect();
-        let r = DMatrix::from_diagonal(&DVector::from_vec(r_diag));
-        let transition =
-            LinearTransition::new(f, DMatrix::identity(t, t) * q).map_err(kalman_error)?;
-        let observation =
-            LinearObservation::new(DMatrix::identity(t, t), r.clone()).map_err(kalman_error)?;
-        let ikf = Ikf::new(transition, observation).map_err(kalman_error)?;
-        // start from P(0|0) = R, with S(0) = F R F^T + Q + R
-        let mut post = r.clone();
-        let mut s = ikf
-            .propagate_covariance::<f64, Dyn, Dyn>(&post)
-            .map_err(kalman_error)?
-            + &r;
-        let mut p_prior = DMatrix::zeros(t, t);
-        let from = post.norm();
-        let diverged = |iterations: usize, to: f64, cause: String| {
-            Error::method(
-                "gskf",
-                Diverged {
-                    q,
-                    from,
-                    to,
-                    iterations,
-                    cause,
-                },
-            )
-        };
-        // an error at the first iteration is one of the inputs (`R`, `Q`), later ones are
-        // the recursion's
-        let failed = |it: usize, to: f64, e: trajpred_kalman::KalmanError| match it {
-            0 => kalman_error(e),
-            _ => diverged(it, to, e.to_string()),
-        };
-        for it in 0..5000 {
-            p_prior = ikf
-                .propagate_covariance::<f64, Dyn, Dyn>(&post)
-                .map_err(|e| failed(it, post.norm(), e))?;
-            let prior = Gaussian {
-                mean: DVector::zeros(t),
-                covariance: p_prior.clone(),
-            };
-            let innov = Innovation::new(DVector::zeros(t), s.clone())?;
-            let next = ikf
-                .correct(&prior, &innov)
-                .map_err(|e| failed(it, p_prior.norm(), e))?
-                .covariance;
-            let change = (&next - &post).norm() / next.norm().max(1e-300);
-            post = next;
-            s = &p_prior + &r;
-            if change < 1e-13 {
-                break;
-            }
-        }
-        if p_prior.iter().any(|v| !v.is_finite()) {
-            return Err(diverged(5000, p_prior.norm(), "a non-finite P".into()));
-        }
-        Ok(AxisFilter {
-            gsc,
-            ikf,
-            p_prior,
-            s,
-            q,
-            correct: true,
-        })
-    }
-
-    /// The GSC alone, without the Kalman correction: the forecast is the GSC's, its
-    /// covariance the diagonal of the GSC residual variances (`R`); no covariance recursion
-    /// is run, so this exists whatever the GSC's coefficients.
-    fn plain(gsc: GroupSparseCoder) -> Result<Self> {
-        let t = gsc.horizons();
-        let r = DMatrix::from_diagonal(&DVector::from_iterator(
-            t,
-            gsc.residual_variances().iter().map(|v| v.max(1e-300)),
-        ));
-        let transition = LinearTransition::new(DMatrix::identity(t, t), DMatrix::zeros(t, t))
-            .map_err(kalman_error)?;
-        let observation =
-            LinearObservation::new(DMatrix::identity(t, t), r.clone()).map_err(kalman_error)?;
-        let ikf = Ikf::new(transition, observation).map_err(kalman_error)?;
-        Ok(AxisFilter {
-            gsc,
-            ikf,
-            p_prior: r.clone(),
-            s: r,
-            q: 0.0,
-            correct: false,
-        })
-    }
-
-    /// The corrected T-step prediction at origin `i` of `x` and its covariance.
-    fn predict(&self, x: &[f64], i: usize) -> Result<Gaussian<f64, Dyn>> {
-        let prior = Gaussian {
-            mean: DVector::from_vec(gsc_at(&self.gsc, x, i)?),
-            covariance: self.p_prior.clone(),
-        };
-        if !self.correct {
-            return Ok(prior);
-        }
-        let v = residuals(&self.gsc, x, i)?;
-        let innov = Innovation::new(v, self.s.clone())?;
-        self.ikf.correct(&prior, &innov).map_err(kalman_error)
-    }
-}
-
-/// Mean squared error of every horizon of the GSKF over the rolling origins of `series`.
-fn in_sample_error(filter: &AxisFilter, series: &[&[f64]]) -> Result<f64> {
-    let (sum, _, n) = errors(filter, series)?;
-    Ok(if n > 0 { sum / n as f64 } else { f64::INFINITY })
-}
-
-/// The sums of squared and of absolute errors of every horizon of the GSKF over the rolling
-/// origins of `series`, and how many errors there are.
-fn errors(filter: &AxisFilter, series: &[&[f64]]) -> Result<(f64, f64, usize)> {
-    let (m, t) = (filter.gsc.window(), filter.gsc.horizons());
-    let (mut sum, mut abs, mut n) = (0.0, 0.0, 0usize);
-    for x in series {
-        for i in (m + t - 1)..x.len().saturating_sub(t) {
-            let g = filter.predict(x, i)?;
-            for k in 0..t {
-                let e = g.mean[k] - x[i + 1 + k];
-                sum += e * e;
-                abs += e.abs();
-                n += 1;
-            }
-        }
-    }
-    Ok((sum, abs, n))
-}
-
 /// The fitted parameters of one axis's coder: `A` (T x m, row by row), `b` and the residual
 /// variances (length T).
 fn coder_json(gsc: &GroupSparseCoder) -> serde_json::Map<String, serde_json::Value> {
@@ -339,6 +196,7 @@ fn axis_fields<'a, const N: usize>(
     params: &GskfParams,
     ax: &At<'a>,
     keys: [&str; N],
+    optional: &[&str],
 ) -> Result<([At<'a>; N], bool)> {
     let saved = match ax.value().get("relative") {
         None => false,
@@ -361,7 +219,8 @@ fn axis_fields<'a, const N: usize>(
             params.relative
         )));
     }
-    Ok((ax.fields_and(keys, &["relative"])?, saved))
+    let allowed: Vec<&str> = optional.iter().copied().chain(["relative"]).collect();
+    Ok((ax.fields_and(keys, &allowed)?, saved))
 }
 
 /// Reads a coder back from its fields `a`, `b`, `residual_variances`, with the shape the
@@ -568,7 +427,7 @@ impl Predictor for Gsc {
             .iter()
             .map(|ax| {
                 let ([a, b, rv], rel) =
-                    axis_fields(&self.params, ax, ["a", "b", "residual_variances"])?;
+                    axis_fields(&self.params, ax, ["a", "b", "residual_variances"], &[])?;
                 coder_from(&self.params, (&a, &b, &rv), rel)
             })
             .collect::<Result<_>>()?;
@@ -603,43 +462,61 @@ impl Gskf {
     }
 
     /// The q chosen (or given) for each axis, once fitted; `None` where the Kalman
-    /// correction is off (the cross-validation found no `q` that beats the plain GSC).
+    /// correction is off (the cross-validation found no `q` that beats the plain GSC) or
+    /// its gain is fitted to the data instead ([`Gskf::fitted_gain_lags`]).
     pub fn process_noise(&self) -> Vec<Option<f64>> {
-        self.axes.iter().map(|a| a.correct.then_some(a.q)).collect()
+        self.axes
+            .iter()
+            .map(|a| (a.correct && a.gain.is_none()).then_some(a.q))
+            .collect()
+    }
+
+    /// For each axis, once fitted, the residual lags of its fitted gain (see
+    /// [`GskfParams::gain_lags`]); `None` where the gain is the IKF's or there is no
+    /// correction.
+    pub fn fitted_gain_lags(&self) -> Vec<Option<usize>> {
+        self.axes
+            .iter()
+            .map(|a| a.gain.as_ref().map(|g| g.lags))
+            .collect()
     }
 
     /// Chooses per axis, on the training series, the `q` of the grid with the lowest
-    /// in-sample mean squared error (one group: nothing to hold out).
-    fn fit_in_sample(&self, train: &[Trajectory]) -> Result<Vec<AxisFilter>> {
+    /// in-sample mean squared error (one group: nothing to hold out), then between that IKF
+    /// and the gains fitted with `gain_lags` on the last quarter of the training origins
+    /// ([`gain::choose_in_time`]). Returns the filters and what was chosen, in words.
+    fn fit_in_sample(&self, train: &[Trajectory]) -> Result<(Vec<AxisFilter>, String)> {
         let coders = fit_axes(&self.params, train, &[])?;
         let needed = self.params.window + self.params.horizons + 1;
-        coders
-            .into_iter()
-            .enumerate()
-            .map(|(a, gsc)| {
-                let scale = mean_residual_variance(&gsc);
-                match self.params.q {
-                    Some(q) => AxisFilter::new(gsc, q),
-                    None => {
-                        let series = axis_series(train, a, needed);
-                        let mut best: Option<(f64, AxisFilter)> = None;
-                        for &g in &self.params.q_grid {
-                            let Ok(f) = AxisFilter::new(gsc.clone(), (g * scale).max(1e-300))
-                            else {
-                                continue;
-                            };
-                            let e = in_sample_error(&f, &series)?;
-                            if best.as_ref().is_none_or(|(b, _)| e < *b) {
-                                best = Some((e, f));
-                            }
-                        }
-                        best.map(|(_, f)| f).ok_or(Error::NotPositiveDefinite {
-                            what: "GSKF covariance recursion for every q of the grid",
-                        })
+        let mut said = String::new();
+        let mut axes = Vec::with_capacity(coders.len());
+        for (a, gsc) in coders.into_iter().enumerate() {
+            let scale = mean_residual_variance(&gsc);
+            let Some(q) = self.params.q else {
+                let series = axis_series(train, a, needed);
+                let mut best: Option<(f64, AxisFilter)> = None;
+                for &g in &self.params.q_grid {
+                    let Ok(f) = AxisFilter::new(gsc.clone(), (g * scale).max(1e-300)) else {
+                        continue;
+                    };
+                    let e = in_sample_error(&f, &series)?;
+                    if best.as_ref().is_none_or(|(b, _)| e < *b) {
+                        best = Some((e, f));
                     }
                 }
-            })
-            .collect()
+                let riccati = best.map(|(_, f)| f).ok_or(Error::NotPositiveDefinite {
+                    what: "GSKF covariance recursion for every q of the grid",
+                })?;
+                let (f, why) = gain::choose_in_time(riccati, &series, &self.params.gain_lags)?;
+                if !why.is_empty() {
+                    let _ = write!(said, "{}axis {a}: {why}", if a > 0 { "; " } else { "" });
+                }
+                axes.push(f);
+                continue;
+            };
+            axes.push(AxisFilter::new(gsc, q)?);
+        }
+        Ok((axes, said))
     }
 }
 
@@ -677,7 +554,9 @@ impl Predictor for Gskf {
         self.axes.clear();
         self.summary = None;
         if self.params.q.is_some() || distinct(groups) < 2 {
-            self.axes = self.fit_in_sample(train)?;
+            let (axes, said) = self.fit_in_sample(train)?;
+            self.axes = axes;
+            self.summary = (!said.is_empty()).then_some(said);
         } else {
             let (steps, steps_said) = match self.params.choose_steps {
                 true => steps::choose_steps(&self.params, train, groups)?,
@@ -711,8 +590,14 @@ impl Predictor for Gskf {
     }
 
     fn min_history(&self) -> usize {
-        // the residual of horizon T needs the prediction made T steps ago
-        self.params.window + self.params.horizons
+        // the residual of horizon T needs the prediction made T steps ago, and a fitted
+        // gain the residuals of `lags` origins before
+        let lags = match self.params.q {
+            Some(_) => 0,
+            None => self.params.gain_lags.iter().copied().max().unwrap_or(0),
+        };
+        let fitted = self.axes.iter().map(AxisFilter::lags).max().unwrap_or(0);
+        self.params.window + self.params.horizons + lags.max(fitted)
     }
 
     fn fitted_summary(&self) -> Option<String> {
@@ -720,9 +605,10 @@ impl Predictor for Gskf {
             let q: Vec<String> = self
                 .axes
                 .iter()
-                .map(|a| match a.correct {
-                    true => format!("{:.3e}", a.q),
-                    false => "off".into(),
+                .map(|a| match (a.correct, &a.gain) {
+                    (true, Some(g)) => format!("fitted gain ({} lags)", g.lags),
+                    (true, None) => format!("{:.3e}", a.q),
+                    (false, _) => "off".into(),
                 })
                 .collect();
             let mut s = format!("q per axis = [{}]", q.join(", "));
@@ -734,7 +620,9 @@ impl Predictor for Gskf {
     }
 
     /// `{"axes": [{"a", "b", "residual_variances", "q", "correct"}, ...]}`: per axis the GSC,
-    /// the process noise and whether the Kalman correction is on; `R` and the converged
+    /// the process noise and whether the Kalman correction is on, and where the gain is
+    /// fitted, `"gain": {"lags", "k", "variances"}` (the gain `T x T (lags + 1)` row by row
+    /// and its residual variances); `R` and the converged
     /// covariances follow from them (recomputed on loading, by the same code, so to the same
     /// bits).
     fn fitted_params(&self) -> Result<serde_json::Value> {
@@ -748,6 +636,9 @@ impl Predictor for Gskf {
                 let mut m = coder_json(&f.gsc);
                 m.insert("q".into(), exact(f.q));
                 m.insert("correct".into(), f.correct.into());
+                if let Some(g) = &f.gain {
+                    m.insert("gain".into(), gain::to_json(g));
+                }
                 serde_json::Value::Object(m)
             })
             .collect();
@@ -762,6 +653,7 @@ impl Predictor for Gskf {
                     &self.params,
                     ax,
                     ["a", "b", "residual_variances", "q", "correct"],
+                    &["gain"],
                 )?;
                 let gsc = coder_from(&self.params, (&a, &b, &rv), rel)?;
                 let on = correct
@@ -769,7 +661,12 @@ impl Predictor for Gskf {
                     .as_bool()
                     .ok_or_else(|| correct.error("expected true or false"))?;
                 let q = q.f64_min(0.0, false)?;
-                if on {
+                if let Some(g) = ax.optional("gain") {
+                    if !on {
+                        return Err(g.error("a fitted gain on an axis whose correction is off"));
+                    }
+                    AxisFilter::fitted(gsc, gain::from_json(&g, self.params.horizons)?)
+                } else if on {
                     AxisFilter::new(gsc, q).map_err(|e| ax.error(e.to_string()))
                 } else {
                     AxisFilter::plain(gsc)

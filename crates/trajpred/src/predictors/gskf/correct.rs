@@ -1,6 +1,8 @@
 //! Whether each axis of a [`Gskf`](super::Gskf) fitted on several groups applies its Kalman
-//! correction, and with which `q`: chosen on held-out groups.
+//! correction, and with which gain (the IKF's for a `q`, or one fitted to the training series
+//! with some residual lags): chosen on held-out groups.
 
+use super::gain::{self, Part};
 use super::{
     AxisFilter, CV_FOLDS, GskfParams, axis_series, errors, fit_axes, mean_residual_variance,
 };
@@ -8,10 +10,12 @@ use crate::predictors::auto::{fold_of_trajectories, fold_split};
 use std::fmt::Write as _;
 use trajpred_core::{Result, Trajectory};
 
-/// Chooses per axis between the plain GSC and each `q` of the grid on [`CV_FOLDS`] folds
-/// by group: the GSC fitted on the other folds, scored on the held-out one's rolling
-/// origins by the mean absolute error (the leaderboard's kind of measure). The best `q`
-/// is the one with the lowest error pooled over the folds; it replaces the plain GSC only
+/// Chooses per axis between the plain GSC, each `q` of the grid and a gain fitted with each
+/// of `params.gain_lags` on [`CV_FOLDS`] folds by group: the GSC (and a fitted gain) fitted on
+/// the other folds, scored on the held-out one's rolling origins (the same origins for every
+/// option: from the first at which the longest lag has its residuals) by the mean absolute
+/// error (the leaderboard's kind of measure). The best correction is the one with the
+/// lowest error pooled over the folds; it replaces the plain GSC only
 /// when it also gains consistently: its mean gain over the folds (the GSC's held-out error
 /// minus its own, fold by fold) must exceed one standard error of that mean (the
 /// one-standard-error rule, with paired folds: a gain that one wild held-out group makes
@@ -26,8 +30,11 @@ pub(super) fn choose(
     let (fold, k) = fold_of_trajectories(groups, CV_FOLDS, 0)?;
     let needed = params.window + params.horizons + 1;
     let grid = &params.q_grid;
-    // per axis, per option (0: no correction, 1..: the grid), per fold: absolute errors
-    // and count
+    let lags = &params.gain_lags;
+    let longest = lags.iter().copied().max().unwrap_or(0);
+    let options = 1 + grid.len() + lags.len();
+    // per axis, per option (0: no correction, 1..: the grid, then the fitted gains), per
+    // fold: absolute errors and count
     let mut sae: Vec<Vec<Vec<(f64, usize)>>> = Vec::new();
     // per axis, per option: why it first failed, for the summary
     let mut why: Vec<Vec<Option<String>>> = Vec::new();
@@ -36,19 +43,14 @@ pub(super) fn choose(
         let Ok(coders) = fit_axes(params, &fit, steps) else {
             continue;
         };
-        sae.resize(coders.len(), vec![vec![(0.0, 0); k]; grid.len() + 1]);
-        why.resize(coders.len(), vec![None; grid.len() + 1]);
+        sae.resize(coders.len(), vec![vec![(0.0, 0); k]; options]);
+        why.resize(coders.len(), vec![None; options]);
         for (a, gsc) in coders.into_iter().enumerate() {
             let series = axis_series(&held, a, needed);
+            let fit_series = axis_series(&fit, a, needed);
             let scale = mean_residual_variance(&gsc);
-            for (o, g) in std::iter::once(None)
-                .chain(grid.iter().map(Some))
-                .enumerate()
-            {
-                let filter = match g {
-                    None => AxisFilter::plain(gsc.clone()),
-                    Some(&g) => AxisFilter::new(gsc.clone(), (g * scale).max(1e-300)),
-                };
+            for o in 0..options {
+                let filter = option_filter(&gsc, o, params, scale, &fit_series);
                 let filter = match filter {
                     Ok(filter) => filter,
                     Err(e) => {
@@ -57,7 +59,7 @@ pub(super) fn choose(
                         continue;
                     }
                 };
-                let (_, e, n) = errors(&filter, &series)?;
+                let (_, e, n) = errors(&filter, &series, longest)?;
                 sae[a][o][f] = (e, n);
             }
         }
@@ -69,7 +71,7 @@ pub(super) fn choose(
         let scale = mean_residual_variance(&gsc);
         let folds = |o: usize| sae.get(a).map_or(&[][..], |row| &row[o][..]);
         let mae = |o: usize| pooled_mae(folds(o));
-        let best_q = (1..=grid.len()).fold(None, |b: Option<usize>, o| match b {
+        let best_q = (1..options).fold(None, |b: Option<usize>, o| match b {
             Some(b) if mae(b) <= mae(o) => Some(b),
             _ if mae(o).is_finite() => Some(o),
             _ => b,
@@ -92,27 +94,55 @@ pub(super) fn choose(
             "; held-out mean absolute error, axis {a}: GSC alone {}",
             shown(0)
         );
-        for (j, g) in grid.iter().enumerate() {
-            let _ = write!(said, ", q = {:.3e}: {}", g * scale, shown(j + 1));
+        for o in 1..options {
+            let _ = write!(said, ", {}: {}", option_name(o, params, scale), shown(o));
         }
         if let (Some(o), Some((mean, se))) = (best_q, gain) {
             let _ = write!(
                 said,
-                "; gain of q = {:.3e} over the GSC per fold {mean:.4e} +- {se:.4e}",
-                grid[o - 1] * scale
+                "; gain of {} over the GSC per fold {mean:.4e} +- {se:.4e}",
+                option_name(o, params, scale)
             );
         }
-        let filter = if best == 0 {
-            let _ = write!(said, " -> no correction");
-            AxisFilter::plain(gsc)?
-        } else {
-            let q = (grid[best - 1] * scale).max(1e-300);
-            let _ = write!(said, " -> q = {q:.3e}");
-            AxisFilter::new(gsc, q)?
-        };
-        axes.push(filter);
+        let _ = write!(said, " -> {}", option_name(best, params, scale));
+        let all = axis_series(train, a, needed);
+        axes.push(option_filter(&gsc, best, params, scale, &all)?);
     }
     Ok((axes, said))
+}
+
+/// Option `o` of [`choose`] for a GSC: 0 the GSC alone, `1..=grid` the IKF with that `q`
+/// (`scale` is the unit of the grid), then a gain with each of `params.gain_lags` fitted on
+/// all the origins of `fit_series`.
+fn option_filter(
+    gsc: &trajpred_sparse::GroupSparseCoder,
+    o: usize,
+    params: &GskfParams,
+    scale: f64,
+    fit_series: &[&[f64]],
+) -> Result<AxisFilter> {
+    let g = params.q_grid.len();
+    if o == 0 {
+        AxisFilter::plain(gsc.clone())
+    } else if o <= g {
+        AxisFilter::new(gsc.clone(), (params.q_grid[o - 1] * scale).max(1e-300))
+    } else {
+        let lags = params.gain_lags[o - 1 - g];
+        let fitted = gain::fit(gsc, fit_series, lags, 0, Part::All)?;
+        AxisFilter::fitted(gsc.clone(), fitted)
+    }
+}
+
+/// Option `o` of [`choose`] in words.
+fn option_name(o: usize, params: &GskfParams, scale: f64) -> String {
+    let g = params.q_grid.len();
+    if o == 0 {
+        "no correction".into()
+    } else if o <= g {
+        format!("q = {:.3e}", (params.q_grid[o - 1] * scale).max(1e-300))
+    } else {
+        format!("fitted gain with {} lags", params.gain_lags[o - 1 - g])
+    }
 }
 
 /// The mean absolute error pooled over folds of `(sum of absolute errors, count)`; infinite

@@ -69,7 +69,7 @@ pub(super) fn choose_steps(
                 let filter = fit_gsc(params, &fit_series, option).and_then(AxisFilter::plain);
                 match filter {
                     Ok(filter) => {
-                        let (_, e, n) = errors(&filter, &held_series)?;
+                        let (_, e, n) = errors(&filter, &held_series, 0)?;
                         row[o].0 += e;
                         row[o].1 += n;
                     }
