@@ -120,7 +120,19 @@ pub(super) fn gsc(m: usize, t: usize) -> Result<Box<dyn Predictor>> {
     })?))
 }
 
+/// MSTPM-GSKF as the paper has it: the IKF's gain only (no fitted gain tried).
 pub(super) fn gskf(m: usize, t: usize) -> Result<Gskf> {
+    Ok(Gskf::new(GskfParams {
+        window: m,
+        horizons: t,
+        gain_lags: Vec::new(),
+        ..Default::default()
+    })?)
+}
+
+/// Our GSKF with its default options: the IKF's gain or one fitted to the training series,
+/// chosen on the last quarter of the training origins (`docs/gskf.md`).
+pub(super) fn gskf_default(m: usize, t: usize) -> Result<Gskf> {
     Ok(Gskf::new(GskfParams {
         window: m,
         horizons: t,

@@ -2,7 +2,7 @@
 //! added to the test part (the paper's setup) or to the whole series with the models refitted
 //! (our variant); and the noise amplification of the fitted recurrence that explains it.
 
-use super::predict::{experiment, fit, gsc, gskf, predict_test, test_truth};
+use super::predict::{experiment, fit, gsc, gskf, gskf_default, predict_test, test_truth};
 use super::{Budget, Setup};
 use crate::report::Figure;
 use crate::runner::Row;
@@ -54,9 +54,11 @@ pub(super) fn spread(v: &[f64]) -> (f64, f64, f64) {
 
 /// The SNR sweep of Fig. 4 at m = T = `s.window`. With `fixed` (GSC and GSKF fitted on the
 /// clean training part), noise is added to the test part only (the paper's experiment);
-/// without, noise is added to the whole series and both models are refitted on its noisy
-/// training part at every SNR and seed. Errors are against the true test points. Returns the
-/// table's rows (one per SNR, keyed by it) and the figure; `paper` holds the paper's points.
+/// without, noise is added to the whole series and the models are refitted on its noisy
+/// training part at every SNR and seed: GSC, the paper's MSTPM-GSKF and our default GSKF
+/// (whose gain may be fitted to the training series). Errors are against the true test
+/// points. Returns the table's rows (one per SNR, keyed by it) and the figure; `paper` holds
+/// the paper's points.
 pub(super) fn snr_sweep(
     ctx: &Context,
     s: &Setup,
@@ -78,7 +80,18 @@ pub(super) fn snr_sweep(
     let bar = ctx.bar((n_snr * budget.noise_seeds) as u64, format!("gskf: {id}"));
     // errors[method][snr][seed] (mm) against the truth; observed[snr][seed]: GSKF against the
     // noisy test values
-    let mut errors = vec![vec![Vec::new(); n_snr]; 2];
+    let names: &[(&str, &str)] = match fixed {
+        Some(_) => &[("gsc", "GSC"), ("gskf", "MSTPM-GSKF")],
+        None => &[
+            ("gsc", "GSC"),
+            ("gskf", "MSTPM-GSKF"),
+            (
+                "gskf_fit",
+                "GSKF, gain chosen on the training series (ours)",
+            ),
+        ],
+    };
+    let mut errors = vec![vec![Vec::new(); n_snr]; names.len()];
     let mut observed = vec![Vec::new(); n_snr];
     for k in 0..budget.noise_seeds {
         // the same draws at every SNR (common random numbers), scaled to it
@@ -94,12 +107,13 @@ pub(super) fn snr_sweep(
                     let train = noisy.prefix(s.train_points)?;
                     let g = fit(gsc(m, t)?, &train)?.predictor;
                     let k = fit(Box::new(gskf(m, t)?), &train)?.predictor;
-                    (noisy, Some([g, k]))
+                    let d = fit(Box::new(gskf_default(m, t)?), &train)?.predictor;
+                    (noisy, Some([g, k, d]))
                 }
             };
-            let models: [&dyn Predictor; 2] = match (&fixed, &refitted) {
-                (Some(f), _) => *f,
-                (None, Some([g, k])) => [g.as_ref(), k.as_ref()],
+            let models: Vec<&dyn Predictor> = match (&fixed, &refitted) {
+                (Some(f), _) => f.to_vec(),
+                (None, Some(r)) => r.iter().map(|p| p.as_ref()).collect(),
                 (None, None) => return Err(experiment(id, "no models")),
             };
             let noisy_truth = test_truth(&noisy, s.test_points);
@@ -116,10 +130,10 @@ pub(super) fn snr_sweep(
     bar.finish_and_clear();
 
     let mut rows = Vec::with_capacity(n_snr);
-    let mut curves: Vec<Vec<(f64, f64, f64, f64)>> = vec![Vec::new(); 2];
+    let mut curves: Vec<Vec<(f64, f64, f64, f64)>> = vec![Vec::new(); names.len()];
     for (si, &snr) in budget.snr_db.iter().enumerate() {
         let mut row = Row::new(format!("{snr}")).set("snr", snr);
-        for (mi, (curve, name)) in curves.iter_mut().zip(["gsc", "gskf"]).enumerate() {
+        for (mi, (curve, (name, _))) in curves.iter_mut().zip(names).enumerate() {
             let (mean, min, max) = spread(&errors[mi][si]);
             curve.push((snr, mean, min, max));
             row = row
@@ -131,7 +145,7 @@ pub(super) fn snr_sweep(
     }
 
     let mut lines = Vec::new();
-    for (mi, name) in ["GSC", "MSTPM-GSKF"].iter().enumerate() {
+    for (mi, (_, name)) in names.iter().enumerate() {
         for (what, pick, markers) in [
             ("mean", 1usize, true),
             ("min over seeds", 2, false),
@@ -147,13 +161,11 @@ pub(super) fn snr_sweep(
             });
         }
     }
-    if fixed.is_some() {
-        lines.push(Series {
-            label: "paper (MSTPM-GSKF)".into(),
-            points: paper.to_vec(),
-            markers: true,
-        });
-    }
+    lines.push(Series {
+        label: "paper (MSTPM-GSKF)".into(),
+        points: paper.to_vec(),
+        markers: true,
+    });
     let figure = Figure {
         id: format!("{id}_snr"),
         caption: format!(
