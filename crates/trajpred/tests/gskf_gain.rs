@@ -98,13 +98,16 @@ fn a_fitted_gain_is_saved_and_loaded_to_the_bit() {
 
     // a gain of the wrong shape, or on an axis whose correction is off, is refused by name
     let mut bad = saved.clone();
-    bad["axes"][0]["gain"]["k"][0].as_array_mut().unwrap().pop();
+    bad["axes"][0]["gain"]["k"][0][0]
+        .as_array_mut()
+        .unwrap()
+        .pop();
     let e = Gskf::new(GskfParams::default())
         .unwrap()
         .load_fitted_params(&bad)
         .unwrap_err();
     assert!(
-        matches!(&e, Error::InvalidFitted { path, .. } if path == "axes[0].gain.k[0]"),
+        matches!(&e, Error::InvalidFitted { path, .. } if path == "axes[0].gain.k[0][0]"),
         "{e:?}"
     );
     let mut off = saved.clone();
@@ -120,7 +123,7 @@ fn a_fitted_gain_is_saved_and_loaded_to_the_bit() {
 }
 
 #[test]
-fn too_many_lags_are_refused_and_a_short_history_is_too_short() {
+fn too_many_lags_are_refused() {
     let e = Gskf::new(params(vec![0, 65])).unwrap_err();
     assert!(
         matches!(
@@ -132,12 +135,48 @@ fn too_many_lags_are_refused_and_a_short_history_is_too_short() {
         ),
         "{e:?}"
     );
-    // window 6 + 6 horizons + 2 lags of the default
-    let p = Gskf::new(GskfParams::default()).unwrap();
-    assert_eq!(p.min_history(), 14);
-    let (noisy, _) = noisy_sinusoid(0.005, 9);
+}
+
+/// A history too short for the chosen lags is corrected with the gain of as many lags as it
+/// has the points for: the same forecast as a model saved with only the gains up to those
+/// lags. The shortest history stays `window + horizons`.
+#[test]
+fn a_short_history_uses_the_gain_of_fewer_lags() {
+    let (noisy, _) = noisy_sinusoid(0.005, 7);
     let mut ours = Gskf::new(GskfParams::default()).unwrap();
     ours.fit(&[noisy.prefix(800).unwrap()]).unwrap();
-    let e = ours.forecast(&noisy.prefix(13).unwrap(), 6).unwrap_err();
-    assert!(matches!(e, Error::TooShort { needed: 14, .. }), "{e:?}");
+    assert_eq!(ours.min_history(), 12);
+    let lags = ours.fitted_gain_lags()[0].unwrap();
+    assert!(lags >= 1, "{:?}", ours.fitted_summary());
+    let saved = ours.fitted_params().unwrap();
+    // a history of 12 + l points has the residuals of l earlier origins
+    for l in 0..lags {
+        let mut cut = saved.clone();
+        let g = &mut cut["axes"][0]["gain"];
+        g["lags"] = l.into();
+        g["k"].as_array_mut().unwrap().truncate(l + 1);
+        g["variances"].as_array_mut().unwrap().truncate(l + 1);
+        let mut fewer = Gskf::new(GskfParams::default()).unwrap();
+        fewer.load_fitted_params(&cut).unwrap();
+        let h = noisy.prefix(12 + l).unwrap();
+        let (a, b) = (
+            ours.forecast(&h, 6).unwrap(),
+            fewer.forecast(&h, 6).unwrap(),
+        );
+        for k in 1..=6 {
+            assert_eq!(
+                a.step(k)[0].to_bits(),
+                b.step(k)[0].to_bits(),
+                "{l} lags, step {k}"
+            );
+        }
+        // and a longer history forecasts differently with all the lags
+        let h = noisy.prefix(12 + lags).unwrap();
+        assert_ne!(
+            ours.forecast(&h, 6).unwrap().step(6),
+            fewer.forecast(&h, 6).unwrap().step(6)
+        );
+    }
+    let e = ours.forecast(&noisy.prefix(11).unwrap(), 6).unwrap_err();
+    assert!(matches!(e, Error::TooShort { needed: 12, .. }), "{e:?}");
 }

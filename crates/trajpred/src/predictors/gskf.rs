@@ -67,8 +67,10 @@ pub struct GskfParams {
     /// the `lags + 1` most recent origins; see `docs/gskf.md`). Chosen on held-out groups with
     /// several groups, else on the last quarter of the training origins against the IKF with
     /// the `q` chosen in sample. Empty: the paper's IKF only. Default `[0, 1, 2]` (since
-    /// 2026-12-07); parameters saved before it read back as empty. Each at most 64; a history
-    /// needs `window + horizons + max(gain_lags)` points.
+    /// 2026-12-07); parameters saved before it read back as empty. Each at most 64. The gains
+    /// with fewer lags are fitted beside the chosen one, and a history shorter than
+    /// `window + horizons + lags` is corrected with the one of as many lags as it has the
+    /// points for.
     #[serde(default)]
     pub gain_lags: Vec<usize>,
 }
@@ -477,7 +479,7 @@ impl Gskf {
     pub fn fitted_gain_lags(&self) -> Vec<Option<usize>> {
         self.axes
             .iter()
-            .map(|a| a.gain.as_ref().map(|g| g.lags))
+            .map(|a| a.gain.as_ref().map(|g| g.lags()))
             .collect()
     }
 
@@ -590,14 +592,9 @@ impl Predictor for Gskf {
     }
 
     fn min_history(&self) -> usize {
-        // the residual of horizon T needs the prediction made T steps ago, and a fitted
-        // gain the residuals of `lags` origins before
-        let lags = match self.params.q {
-            Some(_) => 0,
-            None => self.params.gain_lags.iter().copied().max().unwrap_or(0),
-        };
-        let fitted = self.axes.iter().map(AxisFilter::lags).max().unwrap_or(0);
-        self.params.window + self.params.horizons + lags.max(fitted)
+        // the residual of horizon T needs the prediction made T steps ago (a fitted gain
+        // with lags uses the gain of fewer lags on shorter histories)
+        self.params.window + self.params.horizons
     }
 
     fn fitted_summary(&self) -> Option<String> {
@@ -606,7 +603,7 @@ impl Predictor for Gskf {
                 .axes
                 .iter()
                 .map(|a| match (a.correct, &a.gain) {
-                    (true, Some(g)) => format!("fitted gain ({} lags)", g.lags),
+                    (true, Some(g)) => format!("fitted gain ({} lags)", g.lags()),
                     (true, None) => format!("{:.3e}", a.q),
                     (false, _) => "off".into(),
                 })
@@ -621,10 +618,10 @@ impl Predictor for Gskf {
 
     /// `{"axes": [{"a", "b", "residual_variances", "q", "correct"}, ...]}`: per axis the GSC,
     /// the process noise and whether the Kalman correction is on, and where the gain is
-    /// fitted, `"gain": {"lags", "k", "variances"}` (the gain `T x T (lags + 1)` row by row
-    /// and its residual variances); `R` and the converged
-    /// covariances follow from them (recomputed on loading, by the same code, so to the same
-    /// bits).
+    /// fitted, `"gain": {"lags", "k", "variances"}` (for each number of lags `l` from 0 to
+    /// `lags`, the gain `T x T (l + 1)` row by row and its residual variances); `R` and the
+    /// converged covariances follow from them (recomputed on loading, by the same code, so to
+    /// the same bits).
     fn fitted_params(&self) -> Result<serde_json::Value> {
         if self.axes.is_empty() {
             return Err(not_fitted("gskf"));

@@ -14,8 +14,8 @@ use trajpred_sparse::GroupSparseCoder;
 pub(super) struct AxisFilter {
     pub(super) gsc: GroupSparseCoder,
     ikf: Ikf<LinearTransition<f64, Dyn>, LinearObservation<f64, Dyn, Dyn>>,
-    /// `P(k|k-1)` at convergence (with a fitted gain: the diagonal of its corrected training
-    /// residuals' variances).
+    /// `P(k|k-1)` at convergence (`R` without a correction or with a fitted gain, whose
+    /// forecasts carry their own variances).
     pub(super) p_prior: DMatrix<f64>,
     /// `S(k-1) = P(k-1|k-2) + R` at convergence.
     s: DMatrix<f64>,
@@ -137,11 +137,11 @@ impl AxisFilter {
     }
 
     /// The GSC corrected by a gain fitted to the training series: the forecast is
-    /// `X_hat^0(i) + K z_i` ([`gain::regressors`]), its covariance the diagonal of the
-    /// corrected training residuals' variances.
+    /// `X_hat^0(i) + K z_i` ([`gain::regressors`]) with the gain of as many lags as the
+    /// history has the points for (at most the chosen number), its covariance the diagonal of
+    /// that gain's corrected training residuals' variances.
     pub(super) fn fitted(gsc: GroupSparseCoder, gain: FittedGain) -> Result<Self> {
         let mut f = Self::plain(gsc)?;
-        f.p_prior = DMatrix::from_diagonal(&DVector::from_column_slice(&gain.variances));
         f.correct = true;
         f.gain = Some(gain);
         Ok(f)
@@ -149,7 +149,7 @@ impl AxisFilter {
 
     /// The lags of the fitted gain (0 for the IKF's gain or none).
     pub(super) fn lags(&self) -> usize {
-        self.gain.as_ref().map_or(0, |g| g.lags)
+        self.gain.as_ref().map_or(0, FittedGain::lags)
     }
 
     /// The corrected T-step prediction at origin `i` of `x` and its covariance.
@@ -162,10 +162,16 @@ impl AxisFilter {
             return Ok(prior);
         }
         if let Some(g) = &self.gain {
-            let z = gain::regressors(&self.gsc, x, i, g.lags)?;
+            // origin i has the residuals of i + 1 - m - T earlier origins
+            let have = (i + 1).saturating_sub(self.gsc.window() + self.gsc.horizons());
+            let l = g.lags().min(have);
+            let lg = g.by_lags.get(l).ok_or(Error::NotFitted {
+                method: "gskf".into(),
+            })?;
+            let z = gain::regressors(&self.gsc, x, i, l)?;
             return Ok(Gaussian {
-                mean: prior.mean + &g.k * z,
-                covariance: prior.covariance,
+                mean: prior.mean + &lg.k * z,
+                covariance: DMatrix::from_diagonal(&DVector::from_column_slice(&lg.variances)),
             });
         }
         let v = residuals(&self.gsc, x, i)?;

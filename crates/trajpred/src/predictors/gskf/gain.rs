@@ -22,13 +22,27 @@ use trajpred_sparse::GroupSparseCoder;
 /// The most residual lags a fitted gain may use.
 pub(super) const MAX_LAGS: usize = 64;
 
-/// A gain fitted by least squares: `T x T (lags + 1)`, and the per-horizon variance of the
-/// corrected training residuals (the forecast's covariance).
+/// The gain fitted by least squares with one number of lags: `T x T (lags + 1)`, and the
+/// per-horizon variance of the corrected training residuals (the forecast's covariance).
 #[derive(Debug, Clone, PartialEq)]
-pub(super) struct FittedGain {
-    pub(super) lags: usize,
+pub(super) struct LagGain {
     pub(super) k: DMatrix<f64>,
     pub(super) variances: Vec<f64>,
+}
+
+/// A fitted gain with `lags` lags, and the gains with fewer lags fitted beside it: entry `l`
+/// has `l` lags. A history too short for `lags` lags is corrected with the gain of as many
+/// lags as it has the points for.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct FittedGain {
+    pub(super) by_lags: Vec<LagGain>,
+}
+
+impl FittedGain {
+    /// The number of lags chosen.
+    pub(super) fn lags(&self) -> usize {
+        self.by_lags.len().saturating_sub(1)
+    }
 }
 
 /// Which of a series' usable origins a fit or a score takes: all of them, the first three
@@ -83,10 +97,8 @@ pub(super) fn first_origin(gsc: &GroupSparseCoder, lags: usize) -> usize {
     gsc.window() + gsc.horizons() - 1 + lags
 }
 
-/// Fits the gain with `lags` lags by least squares on the origins `part` of every series
-/// (`first` at least [`first_origin`]). The normal equations are solved by SVD with singular
-/// values below `1e-12` of the largest dropped (the minimum-norm solution when residual
-/// vectors are collinear, as on noise-free series).
+/// Fits the gains with 0 to `lags` lags ([`fit_one`]) on the origins `part` of every series
+/// from `first` (or the first each number of lags can use).
 pub(super) fn fit(
     gsc: &GroupSparseCoder,
     series: &[&[f64]],
@@ -94,6 +106,23 @@ pub(super) fn fit(
     first: usize,
     part: Part,
 ) -> Result<FittedGain> {
+    let by_lags = (0..=lags)
+        .map(|l| fit_one(gsc, series, l, first, part))
+        .collect::<Result<_>>()?;
+    Ok(FittedGain { by_lags })
+}
+
+/// Fits the gain with `lags` lags by least squares on the origins `part` of every series
+/// (`first` at least [`first_origin`]). The normal equations are solved by SVD with singular
+/// values below `1e-12` of the largest dropped (the minimum-norm solution when residual
+/// vectors are collinear, as on noise-free series).
+pub(super) fn fit_one(
+    gsc: &GroupSparseCoder,
+    series: &[&[f64]],
+    lags: usize,
+    first: usize,
+    part: Part,
+) -> Result<LagGain> {
     let t = gsc.horizons();
     let d = t * (lags + 1);
     let first = first.max(first_origin(gsc, lags));
@@ -126,8 +155,7 @@ pub(super) fn fit(
     if k.iter().any(|v| !v.is_finite()) {
         return Err(Error::method("gskf", GainError("a non-finite gain".into())));
     }
-    let mut gain = FittedGain {
-        lags,
+    let mut gain = LagGain {
         k,
         variances: vec![0.0; t],
     };
@@ -207,7 +235,7 @@ pub(super) fn choose_in_time(
     }
     match best {
         Some((_, l)) => {
-            let g = fit(&gsc, series, l, first_origin(&gsc, l), Part::All)?;
+            let g = fit(&gsc, series, l, 0, Part::All)?;
             said.push_str(&format!(" -> fitted gain, {l} lags"));
             Ok((AxisFilter::fitted(gsc, g)?, said))
         }
@@ -218,12 +246,13 @@ pub(super) fn choose_in_time(
     }
 }
 
-/// A fitted gain as saved: `{"lags", "k", "variances"}`, numbers as exact strings.
+/// A fitted gain as saved: `{"lags", "k", "variances"}` with `k` and `variances` one entry
+/// per number of lags from 0 to `lags` (each gain row by row), numbers as exact strings.
 pub(super) fn to_json(g: &FittedGain) -> serde_json::Value {
     serde_json::json!({
-        "lags": g.lags,
-        "k": exact_matrix(&g.k),
-        "variances": exact_vec(&g.variances),
+        "lags": g.lags(),
+        "k": g.by_lags.iter().map(|l| exact_matrix(&l.k)).collect::<Vec<_>>(),
+        "variances": g.by_lags.iter().map(|l| exact_vec(&l.variances)).collect::<Vec<_>>(),
     })
 }
 
@@ -234,15 +263,20 @@ pub(super) fn from_json(at: &At, t: usize) -> Result<FittedGain> {
     if l.fract() != 0.0 || l > MAX_LAGS as f64 {
         return Err(lags.error(format!("expected a whole number up to {MAX_LAGS}, got {l}")));
     }
-    let l = l as usize;
-    Ok(FittedGain {
-        lags: l,
-        k: k.matrix(t, t * (l + 1))?,
-        variances: variances
-            .vector(t, |v| v.f64_min(0.0, true))?
-            .as_slice()
-            .to_vec(),
-    })
+    let n = l as usize + 1;
+    let by_lags = k
+        .items(Some(n), n)?
+        .iter()
+        .zip(variances.items(Some(n), n)?)
+        .enumerate()
+        .map(|(l, (k, v))| {
+            Ok(LagGain {
+                k: k.matrix(t, t * (l + 1))?,
+                variances: v.vector(t, |v| v.f64_min(0.0, true))?.as_slice().to_vec(),
+            })
+        })
+        .collect::<Result<_>>()?;
+    Ok(FittedGain { by_lags })
 }
 
 #[cfg(test)]
@@ -279,12 +313,16 @@ mod tests {
             let got = fit(&gsc, &[&x[..]], lags, first_origin(&gsc, lags), Part::All).unwrap();
             for (r, row) in g["k"].as_array().unwrap().iter().enumerate() {
                 for (c, v) in row.as_array().unwrap().iter().enumerate() {
-                    close(got.k[(r, c)], num(v), &format!("{lags} lags, K[{r}, {c}]"));
+                    close(
+                        got.by_lags[lags].k[(r, c)],
+                        num(v),
+                        &format!("{lags} lags, K[{r}, {c}]"),
+                    );
                 }
             }
             for (k, v) in g["variances"].as_array().unwrap().iter().enumerate() {
                 close(
-                    got.variances[k],
+                    got.by_lags[lags].variances[k],
                     num(v),
                     &format!("{lags} lags, variance {k}"),
                 );
