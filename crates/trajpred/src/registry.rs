@@ -117,7 +117,7 @@ pub const METHODS: &[MethodInfo] = &[
     },
     MethodInfo {
         name: "gskf",
-        description: "GSKF paper: GSC corrected by the improved one-step-ahead Kalman filter",
+        description: "GSKF paper: GSC corrected by the improved one-step-ahead Kalman filter, or by a gain fitted to the training series where held-out data prefer it",
     },
     MethodInfo {
         name: "pf",
