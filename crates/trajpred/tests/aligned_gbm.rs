@@ -308,3 +308,74 @@ fn mirrored_origins_teach_the_turns_the_training_tracks_never_made() {
     let said = |m: &AlignedGbm| m.fitted_summary().expect("fitted");
     assert_ne!(said(&plain), said(&mirrored));
 }
+
+/// Tracks whose last leg misleads, as T-Drive's minutes between fixes do: a vehicle that
+/// waits, then jumps a random distance back or forth along its street, at irregular times.
+fn dithering(k: usize) -> Trajectory {
+    let n = 45;
+    let t: Vec<f64> = (0..n)
+        .map(|i| 60.0 * i as f64 + 7.0 * ((i * 5 + k) % 3) as f64)
+        .collect();
+    let mut s = 0.0;
+    let along: Vec<f64> = (0..n)
+        .map(|i| {
+            // a deterministic jumble of steps of -300..300 m
+            s += 300.0 * (((i * 37 + k * 11) % 13) as f64 / 6.0 - 1.0);
+            s
+        })
+        .collect();
+    let (c, sn) = ((k as f64).cos(), (k as f64).sin());
+    let x = along.iter().map(|s| c * s).collect();
+    let y = along.iter().map(|s| sn * s).collect();
+    Trajectory::from_axes(t, vec![x, y]).expect("finite, increasing")
+}
+
+/// Where the last position forecasts the training tracks better than the last velocity, the
+/// corrections are added to it: it says so, beats `cv-time` by far, saves `"base":
+/// "position"` and loads back to the bit; the braking tracks keep the last velocity and
+/// save no `base` (files as before).
+#[test]
+fn the_base_follows_the_training_tracks_and_is_saved() {
+    let train: Vec<Trajectory> = (0..30).map(dithering).collect();
+    let test: Vec<Trajectory> = (30..36).map(dithering).collect();
+    let mut m = AlignedGbm::new(params()).expect("valid");
+    m.fit(&train).expect("fits");
+    let said = m.fitted_summary().expect("fitted");
+    assert!(said.contains("added to the last position"), "{said}");
+    let mut cv = CvTime::default();
+    cv.fit(&train).expect("fits");
+    let (ours, theirs) = (mean_error(&m, &test), mean_error(&cv, &test));
+    assert!(
+        ours < 0.6 * theirs,
+        "aligned-gbm {ours} m, cv-time {theirs} m"
+    );
+    let saved = m.fitted_params().expect("fitted");
+    assert_eq!(saved["base"], "position");
+    let mut loaded = AlignedGbm::new(params()).expect("valid");
+    loaded.load_fitted_params(&saved).expect("loads");
+    let h = test[0].prefix(30).expect("prefix");
+    let times = &test[0].times()[30..35];
+    let (a, b) = (
+        m.forecast_times(&h, times).expect("forecast"),
+        loaded.forecast_times(&h, times).expect("forecast"),
+    );
+    for k in 1..=5 {
+        assert_eq!(a.step(k), b.step(k), "step {k}");
+    }
+    let mut bad = saved.clone();
+    bad["base"] = "acceleration".into();
+    assert!(matches!(
+        loaded.load_fitted_params(&bad),
+        Err(Error::InvalidFitted { path, .. }) if path == "base"
+    ));
+    let braking = fitted(1);
+    assert!(
+        braking
+            .fitted_params()
+            .expect("fitted")
+            .get("base")
+            .is_none()
+    );
+    let said = braking.fitted_summary().expect("fitted");
+    assert!(said.contains("added to the last velocity"), "{said}");
+}

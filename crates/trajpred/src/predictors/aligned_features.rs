@@ -105,6 +105,78 @@ impl Origin {
     }
 }
 
+/// What an aligned learner's corrections are added to: the last velocity carried over the
+/// time ahead (`tau v0`, the default and the only form before 2026-12-07), or the last
+/// position. Chosen at fit time by which of the two reference forecasts has the lower mean
+/// error over the training origins and steps ([`Base::choose`]): where the last velocity
+/// misleads more than it helps (T-Drive's minutes between fixes), the learner would
+/// otherwise have to learn to cancel `tau v0`, outliers included.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Base {
+    Velocity,
+    Position,
+}
+
+impl Base {
+    /// The base displacement `tau` seconds ahead of `org`, in its aligned frame.
+    pub(super) fn at(self, org: &Origin, tau: f64) -> (f64, f64) {
+        match self {
+            Base::Velocity => (tau * org.v0.0, tau * org.v0.1),
+            Base::Position => (0.0, 0.0),
+        }
+    }
+
+    /// The base whose forecast has the lower mean Euclidean error over every origin with
+    /// `lags` legs behind it and every step 1 to `horizons` inside the training tracks (the
+    /// last velocity on ties), with the two mean errors.
+    pub(super) fn choose(train: &[Trajectory], lags: usize, horizons: usize) -> (Base, f64, f64) {
+        let (mut ev, mut ep, mut n) = (0.0, 0.0, 0usize);
+        for tr in train {
+            let t = tr.times();
+            let (x, y) = xy(tr);
+            for o in lags.max(1)..tr.len().saturating_sub(1) {
+                let dt = t[o] - t[o - 1];
+                let v = ((x[o] - x[o - 1]) / dt, (y[o] - y[o - 1]) / dt);
+                for s in 1..=horizons.min(tr.len() - 1 - o) {
+                    let tau = t[o + s] - t[o];
+                    let d = (x[o + s] - x[o], y[o + s] - y[o]);
+                    ev += (d.0 - tau * v.0).hypot(d.1 - tau * v.1);
+                    ep += d.0.hypot(d.1);
+                    n += 1;
+                }
+            }
+        }
+        let (ev, ep) = (ev / n.max(1) as f64, ep / n.max(1) as f64);
+        let base = if ep < ev {
+            Base::Position
+        } else {
+            Base::Velocity
+        };
+        (base, ev, ep)
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Base::Velocity => "velocity",
+            Base::Position => "position",
+        }
+    }
+}
+
+/// The summary's words for the base: nothing for the last velocity chosen without a
+/// comparison (loaded), else which and the two training errors.
+pub(super) fn base_said(base: Base, errors: Option<(f64, f64)>) -> String {
+    match errors {
+        Some((ev, ep)) => format!(
+            "; corrections added to the last {} (training mean error of the last velocity \
+             {ev:.3} m, of the last position {ep:.3} m)",
+            base.name()
+        ),
+        None if base == Base::Position => "; corrections added to the last position".into(),
+        None => String::new(),
+    }
+}
+
 /// The coefficients of the least-squares polynomial of degree 1 or 2 through `(t_i, v_i)`
 /// with `t` relative to the last time (so the first is the value at the origin), lowest
 /// degree first; zeros when there are fewer points than coefficients. The times must be
@@ -209,9 +281,10 @@ fn shape_features(t: &[f64], x: &[f64], y: &[f64], u: Heading, feats: &mut Vec<f
 /// The forecast of an aligned learner at `times` (checked by the caller): with `c` the
 /// corrections its model gives the history's last origin, one per step (per unit of the
 /// time ahead on the window's grid), the displacement `tau` seconds ahead at step `s` is
-/// `R' [tau v0' + (tau / (s delta)) c_s]`; a third axis follows its last velocity.
+/// `R' [b(tau) + (tau / (s delta)) c_s]`, `b(tau) = tau v0'` or 0 by `base` ([`Base`]); a
+/// third axis follows its last velocity.
 pub(super) fn forecast_at(
-    layout: &Layout,
+    (layout, base): (&Layout, Base),
     history: &Trajectory,
     times: &[f64],
     corrections: impl FnOnce(&Origin) -> Result<Vec<(f64, f64)>>,
@@ -228,7 +301,8 @@ pub(super) fn forecast_at(
         .map(|(i, (&at, (ca, cb)))| {
             let tau = at - t[n - 1];
             let scale = tau / ((i + 1) as f64 * org.delta);
-            let d = org.unrotate((tau * org.v0.0 + scale * ca, tau * org.v0.1 + scale * cb));
+            let b = base.at(&org, tau);
+            let d = org.unrotate((b.0 + scale * ca, b.1 + scale * cb));
             super::displaced_point(history, d, tau)
         })
         .collect();
@@ -246,28 +320,48 @@ pub(super) fn grid_times(history: &Trajectory, window: usize, horizon: usize) ->
 
 impl Layout {
     /// A fitted model's parameters: these settings (`lags`, `window`, `shape_features`), the
-    /// `horizons` and the model under `key`.
-    pub(super) fn saved(&self, horizons: usize, key: &str, model: Value) -> Value {
+    /// `horizons`, `"base": "position"` when the corrections are added to the last position
+    /// ([`Base`]; absent for the last velocity) and the model under `key`.
+    pub(super) fn saved(&self, horizons: usize, base: Base, key: &str, model: Value) -> Value {
         let mut v = serde_json::json!({
             "lags": self.lags,
             "window": self.window,
             "horizons": horizons,
             "shape_features": self.shape,
         });
+        if base != Base::Velocity {
+            // (only then: files saved before the choice stay valid and unchanged)
+            v["base"] = base.name().into();
+        }
         v[key] = model;
         v
     }
 
     /// Reads parameters written by [`Layout::saved`]: checks the settings against these and
-    /// `horizons` (naming the one that differs) and returns the model under `key`.
+    /// `horizons` (naming the one that differs) and returns the model under `key` and the
+    /// base.
     pub(super) fn read_saved<'a>(
         &self,
         horizons: usize,
         root: &At<'a>,
         key: &str,
-    ) -> Result<At<'a>> {
-        let [lags, window, horizons_at, shape, model] =
-            root.fields(["lags", "window", "horizons", "shape_features", key])?;
+    ) -> Result<(At<'a>, Base)> {
+        let [lags, window, horizons_at, shape, model] = root.fields_and(
+            ["lags", "window", "horizons", "shape_features", key],
+            &["base"],
+        )?;
+        let base = match root.optional("base") {
+            None => Base::Velocity,
+            Some(b) => match b.str()? {
+                "velocity" => Base::Velocity,
+                "position" => Base::Position,
+                other => {
+                    return Err(b.error(format!(
+                        "expected \"velocity\" or \"position\", got \"{other}\""
+                    )));
+                }
+            },
+        };
         let saved_shape = shape.bool()?;
         if saved_shape != self.shape {
             return Err(shape.error(format!(
@@ -287,13 +381,15 @@ impl Layout {
                 )));
             }
         }
-        Ok(model)
+        Ok((model, base))
     }
 }
 
 #[cfg(test)]
 mod tests {
+    use super::Base;
     use super::{Layout, Origin, poly_fit};
+    use trajpred_core::Trajectory;
 
     #[test]
     fn every_feature_is_the_same_for_a_turned_and_moved_history() {
@@ -351,5 +447,33 @@ mod tests {
         let [a, b] = poly_fit::<2>(&[0.0, 1.0, 2.0], &[0.0, 1.0, 0.0]);
         assert!((a - 1.0 / 3.0).abs() < 1e-12 && b.abs() < 1e-12, "{a} {b}");
         assert_eq!(poly_fit::<3>(&[0.0, 1.0], &[1.0, 2.0]), [0.0; 3]);
+    }
+
+    /// The two reference errors by hand on a tiny track, and the choice they make: a track
+    /// that goes back and forth (every step undoes the last) is forecast better by its last
+    /// position, one at a constant velocity by its last velocity.
+    #[test]
+    fn the_base_is_the_reference_forecast_with_the_lower_training_error() {
+        // x = 0, 10, 0, 10, 0 at t = 0..4 (y = 0), lags 1, 2 steps: origins 1, 2, 3
+        let zigzag = Trajectory::from_axes(
+            (0..5).map(f64::from).collect(),
+            vec![vec![0.0, 10.0, 0.0, 10.0, 0.0], vec![0.0; 5]],
+        )
+        .unwrap();
+        // origin 1 (v = +10): step 1 d = -10 (velocity error 20, position 10), step 2 d = 0
+        // (20, 0); origin 2 (v = -10): d = +10 (20, 10), d = 0 (20, 0); origin 3: d = -10
+        // (20, 10): velocity 100 / 5, position 30 / 5
+        let (base, ev, ep) = Base::choose(std::slice::from_ref(&zigzag), 1, 2);
+        assert_eq!((base, ev, ep), (Base::Position, 20.0, 6.0));
+        let straight = Trajectory::from_axes(
+            (0..5).map(f64::from).collect(),
+            vec![(0..5).map(|i| 3.0 * f64::from(i)).collect(), vec![0.0; 5]],
+        )
+        .unwrap();
+        let (base, ev, ep) = Base::choose(&[straight], 1, 2);
+        assert_eq!(base, Base::Velocity);
+        assert_eq!(ev, 0.0);
+        // origins 1, 2, 3: displacements 3, 6 | 3, 6 | 3: 21 / 5
+        assert!((ep - 4.2).abs() < 1e-12, "{ep}");
     }
 }

@@ -1,7 +1,7 @@
 //! `aligned-gbm`: gradient-boosted trees that correct the last velocity, learned in the
 //! heading-aligned frame of `aligned-ridge` (issue 27).
 
-use super::aligned_features::{Layout, Origin, forecast_at, grid_times};
+use super::aligned_features::{Base, Layout, Origin, base_said, forecast_at, grid_times};
 use super::fitted::At;
 use super::trees::Ensemble;
 use super::{horizontal_axes as xy, invalid};
@@ -162,9 +162,10 @@ struct Samples {
 
 /// The samples of step `s` (from 1) of one track: every origin with `lags` legs behind it
 /// and step `s` inside the track. The target is the displacement at the step's own time
-/// `tau` minus the last velocity's, in the aligned frame, divided by `tau / (s delta)` (the
-/// correction per unit of the time ahead, on the window's time grid).
-fn samples(p: &AlignedGbmParams, tr: &Trajectory, s: usize, into: &mut Samples) {
+/// `tau` minus the base's ([`Base`]: the last velocity's or none), in the aligned frame,
+/// divided by `tau / (s delta)` (the correction per unit of the time ahead, on the window's
+/// time grid).
+fn samples(p: &AlignedGbmParams, base: Base, tr: &Trajectory, s: usize, into: &mut Samples) {
     let t = tr.times();
     let (x, y) = xy(tr);
     for o in p.lags..tr.len().saturating_sub(s) {
@@ -173,8 +174,9 @@ fn samples(p: &AlignedGbmParams, tr: &Trajectory, s: usize, into: &mut Samples) 
         let d = (x[o + s] - x[o], y[o + s] - y[o]);
         let r = org.u.rotate(d);
         let scale = s as f64 * org.delta / tau;
-        into.along.push((r.0 - tau * org.v0.0) * scale);
-        into.across.push((r.1 - tau * org.v0.1) * scale);
+        let b = base.at(&org, tau);
+        into.along.push((r.0 - b.0) * scale);
+        into.across.push((r.1 - b.1) * scale);
         into.rows.push(org.feats);
     }
 }
@@ -296,6 +298,10 @@ pub struct AlignedGbm {
     models: Vec<[Ensemble; 2]>,
     /// Training origins per step (after the stride), for the summary.
     samples: Vec<usize>,
+    /// What the corrections are added to, chosen at fit time.
+    base: Base,
+    /// The training mean errors of the two bases when fitted here (velocity, position).
+    base_errors: Option<(f64, f64)>,
 }
 
 impl AlignedGbm {
@@ -306,6 +312,8 @@ impl AlignedGbm {
             params,
             models: Vec::new(),
             samples: Vec::new(),
+            base: Base::Velocity,
+            base_errors: None,
         })
     }
 
@@ -315,7 +323,7 @@ impl AlignedGbm {
         let p = &self.params;
         let mut all = Samples::default();
         for tr in train {
-            samples(p, tr, s, &mut all);
+            samples(p, self.base, tr, s, &mut all);
         }
         let n = all.rows.len();
         let keep: Vec<usize> = if n > p.max_samples {
@@ -351,6 +359,9 @@ impl Predictor for AlignedGbm {
     fn fit(&mut self, train: &[Trajectory]) -> Result<()> {
         self.models.clear();
         self.samples.clear();
+        let (base, ev, ep) = Base::choose(train, self.params.lags, self.params.horizons);
+        self.base = base;
+        self.base_errors = Some((ev, ep));
         let steps: Vec<(Vec<f64>, usize, [Vec<f64>; 2])> = (1..=self.params.horizons)
             .into_par_iter()
             .map(|s| self.step_data(train, s))
@@ -420,7 +431,7 @@ impl Predictor for AlignedGbm {
             });
         }
         super::check_fitted_times(NAME, self.models.len(), history, times)?;
-        forecast_at(&self.params.layout(), history, times, |org| {
+        forecast_at((&self.params.layout(), self.base), history, times, |org| {
             Ok(self
                 .models
                 .iter()
@@ -449,13 +460,14 @@ impl Predictor for AlignedGbm {
             .map(|[a, b]| serde_json::json!([a.to_json(), b.to_json()]))
             .collect();
         let p = &self.params;
-        Ok(p.layout().saved(p.horizons, "models", models.into()))
+        Ok(p.layout()
+            .saved(p.horizons, self.base, "models", models.into()))
     }
 
     fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
         let root = At::root(NAME, params);
         let p = &self.params;
-        let models = p.layout().read_saved(p.horizons, &root, "models")?;
+        let (models, base) = p.layout().read_saved(p.horizons, &root, "models")?;
         let max_trees = 1 << 20;
         let models = models
             .items(Some(p.horizons), p.horizons)?
@@ -470,6 +482,8 @@ impl Predictor for AlignedGbm {
             })
             .collect::<Result<Vec<_>>>()?;
         self.models = models;
+        self.base = base;
+        self.base_errors = None;
         self.samples.clear();
         Ok(())
     }
@@ -484,9 +498,10 @@ impl Predictor for AlignedGbm {
             .map(|[a, b]| format!("{}+{}", a.trees(), b.trees()))
             .collect();
         Some(format!(
-            "trees per step (along+across) {}; training origins per step {:?}",
+            "trees per step (along+across) {}; training origins per step {:?}{}",
             trees.join(", "),
-            self.samples
+            self.samples,
+            base_said(self.base, self.base_errors)
         ))
     }
 }

@@ -1,7 +1,7 @@
 //! `aligned-mlp`: a network that corrects the last velocity, learned in the heading-aligned
 //! frame of `aligned-gbm` from the same features, fitted to the mean distance (issue 27).
 
-use super::aligned_features::{Layout, Origin, forecast_at, grid_times};
+use super::aligned_features::{Base, Layout, Origin, base_said, forecast_at, grid_times};
 use super::fitted::{At, exact_vec};
 use super::{horizontal_axes as xy, invalid};
 use rayon::prelude::*;
@@ -134,6 +134,10 @@ pub struct AlignedMlp {
     model: Vec<DistanceMlp>,
     /// Training origins of the last fit, for the summary.
     samples: usize,
+    /// What the corrections are added to, chosen at fit time.
+    base: Base,
+    /// The training mean errors of the two bases when fitted here (velocity, position).
+    base_errors: Option<(f64, f64)>,
 }
 
 impl AlignedMlp {
@@ -144,13 +148,15 @@ impl AlignedMlp {
             params,
             model: Vec::new(),
             samples: 0,
+            base: Base::Velocity,
+            base_errors: None,
         })
     }
 }
 
 /// Row-major training rows of every origin with `horizons` steps ahead inside its track:
-/// the features, the targets (per step, the displacement at the step's time `tau` minus
-/// `tau v0`, aligned) and the scales `tau / (s delta)`.
+/// the features, the targets (per step, the displacement at the step's time `tau` minus the
+/// base's, `tau v0` or none, aligned) and the scales `tau / (s delta)`.
 #[derive(Default)]
 struct Rows {
     feats: Vec<f64>,
@@ -160,7 +166,7 @@ struct Rows {
 }
 
 impl Rows {
-    fn push(&mut self, p: &AlignedMlpParams, tr: &Trajectory) {
+    fn push(&mut self, p: &AlignedMlpParams, base: Base, tr: &Trajectory) {
         let t = tr.times();
         let (x, y) = xy(tr);
         let layout = p.layout();
@@ -169,8 +175,8 @@ impl Rows {
             for s in 1..=p.horizons {
                 let tau = t[o + s] - t[o];
                 let r = org.u.rotate((x[o + s] - x[o], y[o + s] - y[o]));
-                self.targets
-                    .extend([r.0 - tau * org.v0.0, r.1 - tau * org.v0.1]);
+                let b = base.at(&org, tau);
+                self.targets.extend([r.0 - b.0, r.1 - b.1]);
                 self.scales.push(tau / (s as f64 * org.delta));
             }
             self.feats.extend(org.feats);
@@ -204,9 +210,10 @@ impl Predictor for AlignedMlp {
     fn fit(&mut self, train: &[Trajectory]) -> Result<()> {
         self.model.clear();
         let p = &self.params;
+        let (base, ev, ep) = Base::choose(train, p.lags, p.horizons);
         let mut rows = Rows::default();
         for tr in train {
-            rows.push(p, tr);
+            rows.push(p, base, tr);
         }
         let (f, h) = (p.layout().count(), p.horizons);
         let rows = rows.thin(p.max_samples, f, h);
@@ -236,6 +243,8 @@ impl Predictor for AlignedMlp {
             .collect::<Result<Vec<_>>>()?;
         self.model = model;
         self.samples = rows.n;
+        self.base = base;
+        self.base_errors = Some((ev, ep));
         Ok(())
     }
 
@@ -252,7 +261,7 @@ impl Predictor for AlignedMlp {
             });
         }
         super::check_fitted_times(NAME, self.params.horizons, history, times)?;
-        forecast_at(&self.params.layout(), history, times, |org| {
+        forecast_at((&self.params.layout(), self.base), history, times, |org| {
             let mut c = vec![(0.0, 0.0); self.params.horizons];
             let share = 1.0 / self.model.len() as f64;
             for m in &self.model {
@@ -305,13 +314,14 @@ impl Predictor for AlignedMlp {
                 })
             })
             .collect();
-        Ok(p.layout().saved(p.horizons, "networks", networks.into()))
+        Ok(p.layout()
+            .saved(p.horizons, self.base, "networks", networks.into()))
     }
 
     fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
         let root = At::root(NAME, params);
         let p = &self.params;
-        let networks = p.layout().read_saved(p.horizons, &root, "networks")?;
+        let (networks, base) = p.layout().read_saved(p.horizons, &root, "networks")?;
         let (f, h) = (p.layout().count(), p.horizons);
         let model = networks
             .items(None, 1 << 10)?
@@ -350,17 +360,20 @@ impl Predictor for AlignedMlp {
             .collect::<Result<Vec<_>>>()?;
         self.model = model;
         self.samples = 0;
+        self.base = base;
+        self.base_errors = None;
         Ok(())
     }
 
     fn fitted_summary(&self) -> Option<String> {
         let m = self.model.first()?;
         Some(format!(
-            "{} network(s) of {} features to {} steps; {} training origins",
+            "{} network(s) of {} features to {} steps; {} training origins{}",
             self.model.len(),
             m.features(),
             m.pairs(),
-            self.samples
+            self.samples,
+            base_said(self.base, self.base_errors)
         ))
     }
 }
