@@ -137,12 +137,12 @@ pub const METHODS: &[MethodInfo] = &[
     },
     MethodInfo {
         name: "aligned-gbm",
-        description: "last velocity corrected by gradient-boosted trees in the heading-aligned frame",
+        description: "last velocity (or last position, where it forecasts the training tracks better) corrected by gradient-boosted trees in the heading-aligned frame",
     },
     #[cfg(feature = "neural")]
     MethodInfo {
         name: "aligned-mlp",
-        description: "last velocity corrected by a neural network in the heading-aligned frame, fitted to the mean distance",
+        description: "last velocity (or last position, where it forecasts the training tracks better) corrected by a neural network in the heading-aligned frame, fitted to the mean distance",
     },
     MethodInfo {
         name: "auto",

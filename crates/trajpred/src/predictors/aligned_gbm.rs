@@ -446,7 +446,8 @@ impl Predictor for AlignedGbm {
     }
 
     /// `{"lags", "window", "horizons", "shape_features"}` (checked against this predictor's
-    /// parameters on loading) and `"models"`: per step, the along- and across-track tree ensembles
+    /// parameters on loading), `"base": "position"` when the corrections are added to the
+    /// last position, and `"models"`: per step, the along- and across-track tree ensembles
     /// (`{"base", "trees"}`, each tree node by node).
     fn fitted_params(&self) -> Result<serde_json::Value> {
         if self.models.is_empty() {

@@ -282,7 +282,8 @@ impl Predictor for AlignedMlp {
     }
 
     /// `{"lags", "window", "horizons", "shape_features"}` (checked against this predictor's
-    /// parameters on loading) and `"networks"`: per member, the [`DistanceMlp`] (input centre
+    /// parameters on loading), `"base": "position"` when the corrections are added to the
+    /// last position, and `"networks"`: per member, the [`DistanceMlp`] (input centre
     /// and spread, the layers' weights and biases).
     fn fitted_params(&self) -> Result<serde_json::Value> {
         if self.model.is_empty() {
