@@ -342,7 +342,7 @@ fn the_base_follows_the_training_tracks_and_is_saved() {
     m.fit(&train).expect("fits");
     let said = m.fitted_summary().expect("fitted");
     assert!(said.contains("added to the last position"), "{said}");
-    let mut cv = CvTime::default();
+    let mut cv = CvTime::new();
     cv.fit(&train).expect("fits");
     let (ours, theirs) = (mean_error(&m, &test), mean_error(&cv, &test));
     assert!(
