@@ -1,7 +1,9 @@
 //! `aligned-gbm`: what it learns, that its fit does not depend on the threads, and its typed
 //! errors.
 
-use trajpred::predictors::{AlignedGbm, AlignedGbmParams, CvTime};
+use trajpred::predictors::{
+    AlignedGbm, AlignedGbmParams, AlignedRidge, AlignedRidgeParams, CvTime,
+};
 use trajpred_core::{Error, Predictor, Trajectory};
 
 /// Tracks that brake along a heading of their own: speed `10 - 0.2 t` m/s, heading `k`
@@ -378,4 +380,36 @@ fn the_base_follows_the_training_tracks_and_is_saved() {
     );
     let said = braking.fitted_summary().expect("fitted");
     assert!(said.contains("added to the last velocity"), "{said}");
+}
+
+/// `aligned-ridge` chooses its base by the same rule: on the dithering tracks it adds its
+/// corrections to the last position, beats `cv-time`, and saves and loads the choice.
+#[test]
+fn aligned_ridge_chooses_its_base_the_same_way() {
+    let train: Vec<Trajectory> = (0..30).map(dithering).collect();
+    let test: Vec<Trajectory> = (30..36).map(dithering).collect();
+    let p = AlignedRidgeParams {
+        horizons: 5,
+        ..Default::default()
+    };
+    let mut m = AlignedRidge::new(p.clone()).expect("valid");
+    m.fit(&train).expect("fits");
+    let said = m.fitted_summary().expect("fitted");
+    assert!(said.contains("added to the last position"), "{said}");
+    let (ours, theirs) = (mean_error(&m, &test), mean_error(&CvTime::new(), &test));
+    assert!(
+        ours < 0.6 * theirs,
+        "aligned-ridge {ours} m, cv-time {theirs} m"
+    );
+    let saved = m.fitted_params().expect("fitted");
+    assert_eq!(saved["base"], "position");
+    let mut loaded = AlignedRidge::new(p).expect("valid");
+    loaded.load_fitted_params(&saved).expect("loads");
+    assert_eq!(mean_error(&loaded, &test), ours);
+    let mut bad = saved.clone();
+    bad["base"] = 3.into();
+    assert!(matches!(
+        loaded.load_fitted_params(&bad),
+        Err(Error::InvalidFitted { path, .. }) if path == "base"
+    ));
 }

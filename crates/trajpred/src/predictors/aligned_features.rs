@@ -120,8 +120,13 @@ pub(super) enum Base {
 impl Base {
     /// The base displacement `tau` seconds ahead of `org`, in its aligned frame.
     pub(super) fn at(self, org: &Origin, tau: f64) -> (f64, f64) {
+        self.of((tau * org.v0.0, tau * org.v0.1))
+    }
+
+    /// The base displacement given the last velocity's, `by_velocity`: that one or none.
+    pub(super) fn of(self, by_velocity: (f64, f64)) -> (f64, f64) {
         match self {
-            Base::Velocity => (tau * org.v0.0, tau * org.v0.1),
+            Base::Velocity => by_velocity,
             Base::Position => (0.0, 0.0),
         }
     }
@@ -155,7 +160,18 @@ impl Base {
         (base, ev, ep)
     }
 
-    fn name(self) -> &'static str {
+    /// A base as saved: `"velocity"` or `"position"`.
+    pub(super) fn parse(at: &At) -> Result<Base> {
+        match at.str()? {
+            "velocity" => Ok(Base::Velocity),
+            "position" => Ok(Base::Position),
+            other => Err(at.error(format!(
+                "expected \"velocity\" or \"position\", got \"{other}\""
+            ))),
+        }
+    }
+
+    pub(super) fn name(self) -> &'static str {
         match self {
             Base::Velocity => "velocity",
             Base::Position => "position",
@@ -352,15 +368,7 @@ impl Layout {
         )?;
         let base = match root.optional("base") {
             None => Base::Velocity,
-            Some(b) => match b.str()? {
-                "velocity" => Base::Velocity,
-                "position" => Base::Position,
-                other => {
-                    return Err(b.error(format!(
-                        "expected \"velocity\" or \"position\", got \"{other}\""
-                    )));
-                }
-            },
+            Some(b) => Base::parse(&b)?,
         };
         let saved_shape = shape.bool()?;
         if saved_shape != self.shape {

@@ -1,6 +1,7 @@
 //! `aligned-ridge`: a linear correction of the last velocity, learned in a heading-aligned,
 //! time-normalised frame (issue 27, idea b).
 
+use super::aligned_features::{Base, base_said};
 use super::auto::{cv_unit, fold_of_trajectories, fold_split};
 use super::fitted::{At, exact, exact_matrix, exact_vec};
 use super::{Heading, horizontal_axes as xy, invalid};
@@ -203,11 +204,12 @@ impl Normal {
 }
 
 /// The sums of one training trajectory: every origin with `lags` legs behind it, every step
-/// inside the trajectory. The target is the future displacement minus the last velocity's
-/// extrapolation, both in the aligned frame. With `current` weights, each sample is weighed
-/// by the inverse of its residual (reweighted least squares).
+/// inside the trajectory. The target is the future displacement minus the base's (the last
+/// velocity's extrapolation or none, [`Base`]), both in the aligned frame. With `current`
+/// weights, each sample is weighed by the inverse of its residual (reweighted least squares).
 fn accumulate(
     params: &AlignedRidgeParams,
+    base: Base,
     tr: &Trajectory,
     into: &mut Normal,
     current: Option<&[DMatrix<f64>]>,
@@ -223,7 +225,8 @@ fn accumulate(
             let tau = t[o + s] - t[o];
             let d = (x[o + s] - x[o], y[o + s] - y[o]);
             let r = frame.u.rotate(d);
-            let e = (r.0 - tau * frame.v0.0, r.1 - tau * frame.v0.1);
+            let b = base.of((tau * frame.v0.0, tau * frame.v0.1));
+            let e = (r.0 - b.0, r.1 - b.1);
             frame.row(tau, &mut row);
             let m = params.model(frame.v0.0, s);
             let w = current.map_or(1.0, |c| {
@@ -317,10 +320,20 @@ pub struct AlignedRidge {
     /// What the cross-validation's folds were dealt by ([`cv_unit`]).
     #[serde(skip, default = "by_group")]
     cv_unit: &'static str,
+    /// What the corrections are added to, chosen at fit time ([`Base`]).
+    #[serde(skip, default = "velocity")]
+    base: Base,
+    /// The training mean errors of the two bases when fitted here (velocity, position).
+    #[serde(skip)]
+    base_errors: Option<(f64, f64)>,
 }
 
 fn by_group() -> &'static str {
     "group"
+}
+
+fn velocity() -> Base {
+    Base::Velocity
 }
 
 impl AlignedRidge {
@@ -332,6 +345,8 @@ impl AlignedRidge {
             weights: Vec::new(),
             chosen: None,
             cv_unit: by_group(),
+            base: Base::Velocity,
+            base_errors: None,
         })
     }
 
@@ -362,7 +377,7 @@ impl AlignedRidge {
             .map(|chunk| {
                 let mut n = self.zeros();
                 for tr in chunk {
-                    accumulate(&self.params, tr, &mut n, current);
+                    accumulate(&self.params, self.base, tr, &mut n, current);
                 }
                 n
             })
@@ -429,6 +444,11 @@ impl Predictor for AlignedRidge {
             });
         }
         self.weights.clear();
+        // the base on all the training data (a fixed rule, nothing fitted), the same in
+        // every fold of the strength's cross-validation
+        let (base, ev, ep) = Base::choose(train, self.params.lags, self.params.horizons);
+        self.base = base;
+        self.base_errors = Some((ev, ep));
         let (lambda, scores) = match self.params.lambda {
             Some(l) => (l, Vec::new()),
             None => {
@@ -485,7 +505,7 @@ impl Predictor for AlignedRidge {
                 let w = &self.weights[self.params.model(frame.v0.0, i + 1)];
                 let tau = at - t[n - 1];
                 frame.row(tau, &mut row);
-                let (mut a, mut b) = (tau * frame.v0.0, tau * frame.v0.1);
+                let (mut a, mut b) = self.base.of((tau * frame.v0.0, tau * frame.v0.1));
                 for (i, r) in row.iter().enumerate() {
                     a += r * w[(i, 0)];
                     b += r * w[(i, 1)];
@@ -511,19 +531,30 @@ impl Predictor for AlignedRidge {
             });
         };
         let p = &self.params;
-        Ok(serde_json::json!({
+        let mut v = serde_json::json!({
             "lags": p.lags,
             "horizons": p.horizons,
             "speed_bins": exact_vec(&p.speed_bins),
             "lambda": exact(*lambda),
             "weights": self.weights.iter().map(exact_matrix).collect::<Vec<_>>(),
-        }))
+        });
+        if self.base != Base::Velocity {
+            // (only then: files saved before the choice stay valid and unchanged)
+            v["base"] = self.base.name().into();
+        }
+        Ok(v)
     }
 
     fn load_fitted_params(&mut self, params: &serde_json::Value) -> Result<()> {
         let root = At::root("aligned-ridge", params);
-        let [lags, horizons, bins, lambda, weights] =
-            root.fields(["lags", "horizons", "speed_bins", "lambda", "weights"])?;
+        let [lags, horizons, bins, lambda, weights] = root.fields_and(
+            ["lags", "horizons", "speed_bins", "lambda", "weights"],
+            &["base"],
+        )?;
+        let base = match root.optional("base") {
+            None => Base::Velocity,
+            Some(b) => Base::parse(&b)?,
+        };
         let p = &self.params;
         let same = |at: &At, saved: f64, ours: usize, option: &str| {
             if saved == ours as f64 {
@@ -552,6 +583,8 @@ impl Predictor for AlignedRidge {
             .collect::<Result<Vec<_>>>()?;
         self.weights = weights;
         self.chosen = Some((lambda, Vec::new()));
+        self.base = base;
+        self.base_errors = None;
         Ok(())
     }
 
@@ -569,6 +602,7 @@ impl Predictor for AlignedRidge {
                 cv.join(", ")
             ));
         }
+        s.push_str(&base_said(self.base, self.base_errors));
         Some(s)
     }
 }
