@@ -66,7 +66,7 @@ pub struct GskfParams {
     /// are tried beside the IKF's (a gain fitted by least squares on the residual vectors of
     /// the `lags + 1` most recent origins; see `docs/gskf.md`). Chosen on held-out groups with
     /// several groups, else on the last quarter of the training origins against the IKF with
-    /// the `q` chosen in sample. Empty: the paper's IKF only. Default `[0, 1, 2]` (since
+    /// the `q` chosen in sample. Empty: the paper's IKF only. Default `[0, 1, 2, 4]` (since
     /// 2026-12-07); parameters saved before it read back as empty. Each at most 64. The gains
     /// with fewer lags are fitted beside the chosen one, and a history shorter than
     /// `window + horizons + lags` is corrected with the one of as many lags as it has the
@@ -85,7 +85,7 @@ impl Default for GskfParams {
             choose_steps: true,
             relative: false,
             choose_frame: true,
-            gain_lags: vec![0, 1, 2],
+            gain_lags: vec![0, 1, 2, 4],
         }
     }
 }
