@@ -437,8 +437,129 @@ pub fn split(
 }
 
 /// Splits segments into (train, test) as `how` says, keeping their order within each side
-/// for [`Split::ByTime`] and the shuffled order otherwise.
+/// for [`Split::ByTime`] and the shuffled order otherwise, then leaves out the segments that
+/// repeat another exactly ([`drop_repeats`]; [`split_segments_counted`] says how many).
 pub fn split_segments(segments: &[Segment], how: Split) -> Result<(Vec<Segment>, Vec<Segment>)> {
+    split_segments_counted(segments, how).map(|(train, test, _)| (train, test))
+}
+
+/// [`split_segments`] with the count of the repeated segments it left out.
+pub fn split_segments_counted(
+    segments: &[Segment],
+    how: Split,
+) -> Result<(Vec<Segment>, Vec<Segment>, Repeats)> {
+    let (train, test) = split_sides(segments, how)?;
+    Ok(drop_repeats(train, test))
+}
+
+/// Segments left out of a split because they repeat another segment exactly: the same
+/// frame, timestamps and points, whatever their group or id ([`drop_repeats`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Repeats {
+    /// Training segments equal to an earlier training segment.
+    pub train: usize,
+    /// Test segments equal to a training segment: kept, they would test the methods on
+    /// data they were fitted on.
+    pub test_of_train: usize,
+    /// Test segments equal to an earlier test segment: kept, they would count twice.
+    pub test: usize,
+}
+
+impl Repeats {
+    /// Segments left out in all.
+    pub fn total(&self) -> usize {
+        self.train + self.test_of_train + self.test
+    }
+}
+
+fn segment_key(s: &Segment) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    format!("{:?}", s.frame).hash(&mut h);
+    s.trajectory.len().hash(&mut h);
+    for t in s.trajectory.times() {
+        t.to_bits().hash(&mut h);
+    }
+    for axis in s.trajectory.axes() {
+        for v in axis {
+            v.to_bits().hash(&mut h);
+        }
+    }
+    h.finish()
+}
+
+/// Leaves out every segment that repeats another exactly (the same frame, timestamps and
+/// points; groups and ids are not compared): a training segment equal to an earlier
+/// training one, and a test segment equal to a training one or to an earlier test one. The
+/// first copy stays; the order of the rest is kept.
+///
+/// Datasets hold such copies: in `../shared/data`'s GeoLife subset, users 058 and 059, 069
+/// and 129, 081 and 136, 087 and 111, 108 and 139 share 28 files byte for byte (every file
+/// of 059 is one of 058's), so a split by user may put one copy on each side and test the
+/// methods on data they were fitted on.
+///
+/// ```
+/// use trajpred::dataset::Segment;
+/// use trajpred::harness::drop_repeats;
+/// use trajpred_core::Trajectory;
+/// use trajpred_data::Frame;
+///
+/// let seg = |group: &str, x0: f64| Segment {
+///     group: group.into(),
+///     id: group.into(),
+///     frame: Frame::Cartesian,
+///     trajectory: Trajectory::new(vec![0.0, 1.0], vec![[x0, 0.0], [x0 + 1.0, 0.0]]).unwrap(),
+/// };
+/// // user b's track is a copy of user a's; c's is its own
+/// let (train, test, r) = drop_repeats(vec![seg("a", 0.0)], vec![seg("b", 0.0), seg("c", 5.0)]);
+/// assert_eq!((train.len(), test.len(), r.test_of_train), (1, 1, 1));
+/// assert_eq!(test[0].group, "c");
+/// ```
+pub fn drop_repeats(
+    train: Vec<Segment>,
+    test: Vec<Segment>,
+) -> (Vec<Segment>, Vec<Segment>, Repeats) {
+    let same = |a: &Segment, b: &Segment| a.frame == b.frame && a.trajectory == b.trajectory;
+    // key -> kept segments with that key: (in training?, index in its side)
+    let mut index: std::collections::HashMap<u64, Vec<(bool, usize)>> =
+        std::collections::HashMap::new();
+    let mut r = Repeats::default();
+    let mut kept_train: Vec<Segment> = Vec::with_capacity(train.len());
+    for s in train {
+        let list = index.entry(segment_key(&s)).or_default();
+        if list.iter().any(|&(_, i)| same(&kept_train[i], &s)) {
+            r.train += 1;
+        } else {
+            list.push((true, kept_train.len()));
+            kept_train.push(s);
+        }
+    }
+    let mut kept_test: Vec<Segment> = Vec::with_capacity(test.len());
+    for s in test {
+        let list = index.entry(segment_key(&s)).or_default();
+        let hit = list.iter().find(|&&(in_train, i)| {
+            same(
+                if in_train {
+                    &kept_train[i]
+                } else {
+                    &kept_test[i]
+                },
+                &s,
+            )
+        });
+        match hit {
+            Some(&(true, _)) => r.test_of_train += 1,
+            Some(_) => r.test += 1,
+            None => {
+                list.push((false, kept_test.len()));
+                kept_test.push(s);
+            }
+        }
+    }
+    (kept_train, kept_test, r)
+}
+
+fn split_sides(segments: &[Segment], how: Split) -> Result<(Vec<Segment>, Vec<Segment>)> {
     use rand::SeedableRng;
     use rand::seq::SliceRandom;
     match how {

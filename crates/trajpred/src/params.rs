@@ -8,7 +8,8 @@
 //!   "format": "trajpred-params",
 //!   "version": 1,
 //!   "fitted_on": { protocol, dataset, path, segmentation, split, seed, max_units,
-//!                  max_train, segments, train_segments, train_points },
+//!                  max_train, segments, train_segments, train_points,
+//!                  repeated_train_segments },
 //!   "methods": [ { label, name, options, summary, fit_seconds, params }, ... ]
 //! }
 //! ```
@@ -222,6 +223,10 @@ pub struct FittedOn {
     pub train_segments: usize,
     /// Points in them.
     pub train_points: usize,
+    /// Training segments the split left out as exact repeats of others
+    /// ([`harness::drop_repeats`]; 0 in files written before it).
+    #[serde(default)]
+    pub repeated_train_segments: usize,
 }
 
 /// One method's saved parameters.
@@ -324,7 +329,7 @@ pub fn fit(
     };
     protocol.validate().map_err(whole)?;
     check_exportable(&protocol.methods)?;
-    let (train, _) = protocol::split(protocol, segments).map_err(whole)?;
+    let (train, _, repeats) = protocol::split_counted(protocol, segments).map_err(whole)?;
     let train_tr: Vec<Trajectory> = train.iter().map(|s| s.trajectory.clone()).collect();
     let groups = harness::group_ids(&train);
     let mut methods = Vec::with_capacity(protocol.methods.len());
@@ -367,6 +372,7 @@ pub fn fit(
             segments: segments.len(),
             train_segments: train.len(),
             train_points: train_tr.iter().map(Trajectory::len).sum(),
+            repeated_train_segments: repeats.train,
         },
         methods,
         source: unsaved(),

@@ -369,6 +369,8 @@ pub struct ProtocolRun {
     pub train: Vec<Segment>,
     /// The test segments used.
     pub test: Vec<Segment>,
+    /// Segments the split left out for repeating another ([`harness::drop_repeats`]).
+    pub repeats: harness::Repeats,
 }
 
 fn mean(v: impl IntoIterator<Item = f64>) -> f64 {
@@ -380,17 +382,26 @@ fn mean(v: impl IntoIterator<Item = f64>) -> f64 {
     if n == 0 { f64::NAN } else { s / n as f64 }
 }
 
-/// The (training, test) segments of `protocol`: its split, then its caps. What [`run`] fits
-/// and tests on, and what `trajpred fit` fits on.
+/// The (training, test) segments of `protocol`: its split (repeated segments left out,
+/// [`harness::drop_repeats`]), then its caps. What [`run`] fits and tests on, and what
+/// `trajpred fit` fits on.
 pub fn split(protocol: &Protocol, segments: &[Segment]) -> Result<(Vec<Segment>, Vec<Segment>)> {
-    let (mut train, mut test) = harness::split_segments(segments, protocol.split)?;
+    split_counted(protocol, segments).map(|(train, test, _)| (train, test))
+}
+
+/// [`split`] with the count of the repeated segments left out.
+pub fn split_counted(
+    protocol: &Protocol,
+    segments: &[Segment],
+) -> Result<(Vec<Segment>, Vec<Segment>, harness::Repeats)> {
+    let (mut train, mut test, repeats) = harness::split_segments_counted(segments, protocol.split)?;
     if let Some(n) = protocol.max_train {
         train.truncate(n);
     }
     if let Some(n) = protocol.max_test {
         test.truncate(n);
     }
-    Ok((train, test))
+    Ok((train, test, repeats))
 }
 
 /// Makes the predictor of a method for [`run_with`], given the training trajectories and
@@ -428,8 +439,14 @@ pub fn run_with(
     fitter: &Fitter<'_>,
 ) -> Result<ProtocolRun> {
     protocol.validate()?;
-    let (train, test) = split(protocol, segments)?;
-    run_split(protocol, segments.len(), train, test, progress, fitter)
+    let (train, test, repeats) = split_counted(protocol, segments)?;
+    run_split(
+        protocol,
+        segments.len(),
+        (train, test, repeats),
+        progress,
+        fitter,
+    )
 }
 
 /// [`run_with`] on a split already made: makes each method's predictor with `fitter` from
@@ -438,8 +455,7 @@ pub fn run_with(
 fn run_split(
     protocol: &Protocol,
     segments: usize,
-    train: Vec<Segment>,
-    test: Vec<Segment>,
+    (train, test, repeats): (Vec<Segment>, Vec<Segment>, harness::Repeats),
     progress: &dyn Progress,
     fitter: &Fitter<'_>,
 ) -> Result<ProtocolRun> {
@@ -447,8 +463,14 @@ fn run_split(
         return Err(Error::InvalidParameter {
             name: "segments",
             reason: format!(
-                "{} segments of at least {} points: too few for a test part",
-                segments, protocol.segmentation.min_points
+                "{} segments of at least {} points: too few for a test part{}",
+                segments,
+                protocol.segmentation.min_points,
+                match repeats.test_of_train + repeats.test {
+                    0 => String::new(),
+                    n =>
+                        format!(" ({n} test segments left out as exact repeats of other segments)"),
+                }
             ),
         });
     }
@@ -499,14 +521,16 @@ fn run_split(
         fit_seconds,
         train,
         test,
+        repeats,
     })
 }
 
 /// Cross-validation by group: the groups (users, vehicles) of `segments` are dealt into
 /// `folds` folds ([`harness::group_folds`], seeded by `seed`); each fold's segments are the
 /// test part once, with the other folds' segments training. The protocol's own split and
-/// `max_train` are not used (every other fold trains); `max_test` still bounds each test
-/// part. One [`ProtocolRun`] per fold, in fold order.
+/// `max_train` are not used (every other fold trains); repeated segments are left out of
+/// each fold ([`harness::drop_repeats`]) and `max_test` still bounds each test part. One
+/// [`ProtocolRun`] per fold, in fold order.
 pub fn cross_validate(
     protocol: &Protocol,
     segments: &[Segment],
@@ -528,14 +552,14 @@ pub fn cross_validate(
                     train.push(s.clone());
                 }
             }
+            let (train, mut test, repeats) = harness::drop_repeats(train, test);
             if let Some(n) = protocol.max_test {
                 test.truncate(n);
             }
             run_split(
                 protocol,
                 segments.len(),
-                train,
-                test,
+                (train, test, repeats),
                 progress,
                 &build_and_fit,
             )

@@ -273,6 +273,47 @@ fn folds_deal_every_user_into_exactly_one_test_part() {
     assert_eq!(tested, all);
 }
 
+#[test]
+fn no_fold_tests_a_copy_of_one_of_its_training_segments() {
+    // user "copy" holds u0's two tracks again, as GeoLife's user 059 holds files of 058
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let mut segments: Vec<Segment> = (0..6)
+        .flat_map(|u| (0..2).map(move |i| (u, i)))
+        .map(|(u, i)| segment(&format!("u{u}"), i, straight(&mut rng)))
+        .collect();
+    let copies: Vec<Segment> = segments[..2]
+        .iter()
+        .enumerate()
+        .map(|(i, s)| segment("copy", i, s.trajectory.clone()))
+        .collect();
+    segments.extend(copies);
+    let (mut straddled, mut seeds) = (0, 0);
+    for seed in 0..8 {
+        let runs =
+            protocol::cross_validate(&custom_protocol(&["cv-time"]), &segments, 3, seed, &Silent)
+                .unwrap();
+        for r in &runs {
+            for s in &r.test {
+                assert!(
+                    r.train.iter().all(|t| t.trajectory != s.trajectory),
+                    "seed {seed}: {} tests a copy of a training segment",
+                    s.id
+                );
+            }
+            let r2 = r.repeats;
+            assert_eq!(r.train.len() + r.test.len() + r2.total(), segments.len());
+            straddled += r2.test_of_train;
+        }
+        seeds += 1;
+    }
+    // u0 and the copy fell into different folds under some seeds: then the copy on the
+    // test side was left out (the copy on the training side stays)
+    assert!(
+        straddled > 0,
+        "no seed of {seeds} put the copies in different folds"
+    );
+}
+
 const SHARED_CANDIDATES: &[&str] = &["cv-time", "last-position", "poly1", "kf-cv"];
 
 /// Tracks that walk, turn and stand, with noisy fixes at irregular times.

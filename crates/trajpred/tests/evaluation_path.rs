@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use trajpred::dataset::{Dataset, Segment, Segmentation, load};
-use trajpred::harness::{Split, split_segments};
+use trajpred::harness::{Split, split_segments, split_segments_counted};
 use trajpred_core::{Error, Trajectory};
 
 fn run(args: &[&str]) -> Output {
@@ -120,13 +120,13 @@ fn segmentation_splits_at_gaps_and_resamples_inside_segments_only() {
 
 #[test]
 fn split_by_user_keeps_every_user_on_one_side() {
-    let tr = Trajectory::uniform(0.0, 1.0, vec![vec![0.0, 1.0, 2.0]]).expect("track");
     let segments: Vec<Segment> = (0..40)
         .map(|i| Segment {
             group: format!("user{}", i % 7),
             id: format!("s{i}"),
             frame: trajpred_data::Frame::Cartesian,
-            trajectory: tr.clone(),
+            trajectory: Trajectory::uniform(0.0, 1.0, vec![vec![0.0, 1.0, f64::from(i)]])
+                .expect("track"),
         })
         .collect();
     let how = Split::ByGroup {
@@ -182,6 +182,64 @@ fn split_by_user_keeps_every_user_on_one_side() {
     }
 }
 
+#[test]
+fn splits_leave_out_exact_repeats_so_no_test_segment_is_a_training_one() {
+    // 6 users with 3 tracks each; "copy" repeats user0's three (as GeoLife's user 059
+    // repeats files of 058) and "twin" repeats user1's first, under its own id
+    let track = |k: usize| {
+        let xs: Vec<f64> = (0..30).map(|i| (i * (k + 1)) as f64).collect();
+        Trajectory::uniform(100.0 * k as f64, 1.0, vec![xs, vec![k as f64; 30]]).expect("track")
+    };
+    let seg = |g: &str, k: usize| Segment {
+        group: g.into(),
+        id: format!("{g}/{k}"),
+        frame: trajpred_data::Frame::Cartesian,
+        trajectory: track(k),
+    };
+    let mut segments: Vec<Segment> = (0..18).map(|k| seg(&format!("user{}", k / 3), k)).collect();
+    segments.extend((0..3).map(|k| seg("copy", k)));
+    segments.push(seg("twin", 3));
+    let mut straddled = 0;
+    for seed in 0..12 {
+        for how in [
+            Split::ByGroup {
+                train_fraction: 0.3,
+                seed,
+            },
+            Split::ByTrajectory {
+                train_fraction: 0.3,
+                seed,
+            },
+        ] {
+            let (train, test, r) = split_segments_counted(&segments, how).expect("split");
+            assert_eq!(train.len() + test.len() + r.total(), segments.len());
+            // every one of the 18 distinct tracks is kept exactly once
+            let kept: Vec<&Trajectory> = train.iter().chain(&test).map(|s| &s.trajectory).collect();
+            assert_eq!(kept.len(), 18, "{how:?}: {r:?}");
+            for (i, a) in kept.iter().enumerate() {
+                assert!(
+                    kept[i + 1..].iter().all(|b| b != a),
+                    "{how:?}: a repeat kept"
+                );
+            }
+            for s in &test {
+                assert!(
+                    train.iter().all(|t| t.trajectory != s.trajectory),
+                    "{how:?}: {} tests a copy of a training segment",
+                    s.id
+                );
+            }
+            straddled += r.test_of_train;
+            // the plain split is the same split
+            assert_eq!(
+                split_segments(&segments, how).expect("split"),
+                (train, test)
+            );
+        }
+    }
+    assert!(straddled > 0, "no seed put a copy on each side");
+}
+
 /// A CSV folder: two files, each with an `id` column holding two walkers, epoch-millisecond
 /// times sampled every 2 s, and a 60 s pause in the middle of every track.
 fn write_csv_folder(dir: &Path) {
@@ -192,7 +250,11 @@ fn write_csv_folder(dir: &Path) {
                 let pause = if i >= 40 { 60_000 } else { 0 };
                 let ms = 1_224_730_384_000u64 + u64::from(i) * 2000 + pause;
                 let t = f64::from(i) * 2.0;
-                let (lat, lon) = lat_lon(1.5 * t, (0.2 * t + f64::from(w)).sin() * 5.0 + t);
+                // each walker of each file its own track (exact copies are left out)
+                let (lat, lon) = lat_lon(
+                    1.5 * t + 50.0 * f64::from(f as u32),
+                    (0.2 * t + f64::from(w)).sin() * 5.0 + t,
+                );
                 let _ = writeln!(s, "walker{f}{w},{ms},{lat:.7},{lon:.7}");
             }
         }
@@ -334,7 +396,7 @@ fn protocols_are_listed_and_unknown_ones_name_the_known() {
 /// GeoLife in its real layout (`<root>/Data/<user>/Trajectory/*.plt`): 3 users, 2 files each
 /// of 70 fixes 1-3 s apart, with a 20 s pause after fix 60.
 fn write_geolife(root: &Path) {
-    for user in ["010", "011", "012"] {
+    for (u, user) in ["010", "011", "012"].into_iter().enumerate() {
         let dir = root.join("Data").join(user).join("Trajectory");
         std::fs::create_dir_all(&dir).expect("folder");
         for day in 1..=2u32 {
@@ -346,7 +408,11 @@ fn write_geolife(root: &Path) {
             for i in 0..70u32 {
                 t += [1, 2, 3][(i % 3) as usize] + if i == 60 { 20 } else { 0 };
                 let tf = f64::from(t);
-                let (lat, lon) = lat_lon(2.0 * tf + (tf / 9.0).sin() * 4.0, tf * f64::from(day));
+                // each user's files their own (exact copies are left out of splits)
+                let (lat, lon) = lat_lon(
+                    2.0 * tf + (tf / 9.0).sin() * 4.0 + 100.0 * u as f64,
+                    tf * f64::from(day),
+                );
                 let days = 39744.0 + f64::from(day) + f64::from(t) / 86400.0;
                 let _ = writeln!(
                     s,

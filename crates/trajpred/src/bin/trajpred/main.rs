@@ -335,6 +335,19 @@ fn say_skips(loaded: &Loaded) {
 }
 
 /// Tells on stderr what each fitted method chose (`auto`'s pick and fold scores, ...).
+/// What the split left out as exact repeats ([`trajpred::harness::drop_repeats`]), for the
+/// line that counts the segments; empty when nothing was.
+fn repeats_note(r: &trajpred::harness::Repeats) -> String {
+    if r.total() == 0 {
+        return String::new();
+    }
+    format!(
+        "; left out as exact repeats of other segments: {} training, {} test (copies of \
+         training segments), {} test (copies of test segments)",
+        r.train, r.test_of_train, r.test
+    )
+}
+
 fn say_fitted(run: &protocol::ProtocolRun) {
     for (label, p) in run.labels.iter().zip(&run.predictors) {
         if let Some(s) = p.fitted_summary() {
@@ -547,9 +560,10 @@ fn run(cli: Cli) -> Result<()> {
                 let runs = protocol::cross_validate(&p, &loaded.segments, k, seed, &bars)?;
                 for (f, r) in runs.iter().enumerate() {
                     eprintln!(
-                        "fold {f}: {} training and {} test segments",
+                        "fold {f}: {} training and {} test segments{}",
                         r.train.len(),
-                        r.test.len()
+                        r.test.len(),
+                        repeats_note(&r.repeats)
                     );
                     say_fitted(r);
                 }
@@ -577,11 +591,12 @@ fn run(cli: Cli) -> Result<()> {
                 eprintln!("wrote {}", path.display());
             }
             eprintln!(
-                "{}: {} training and {} test segments ({} split)",
+                "{}: {} training and {} test segments ({} split){}",
                 p.name,
                 run.train.len(),
                 run.test.len(),
-                p.split.label()
+                p.split.label(),
+                repeats_note(&run.repeats)
             );
             if p.histories.len() == 1 {
                 let reports: Vec<MethodReport> = run
@@ -695,6 +710,12 @@ fn run(cli: Cli) -> Result<()> {
                 println!(
                     "{}: {what} ({} training segments, {} points, {:.2} s)",
                     m.label, on.train_segments, on.train_points, m.fit_seconds
+                );
+            }
+            if on.repeated_train_segments > 0 {
+                eprintln!(
+                    "left out {} training segments that repeat another exactly",
+                    on.repeated_train_segments
                 );
             }
             eprintln!("wrote {}", output.display());
