@@ -7,8 +7,8 @@
 //! cargo run --release -p trajpred --example tune_by_user -- geolife ../shared/data/geolife 5 55
 //! ```
 //! (dataset, path, `--max-gap`, `--min-points`; a fifth argument `gbm` scores
-//! `aligned-gbm`'s variants instead, with a sixth `1` to `10` for the first to tenth round
-//! of them; the split is `--split by-user`,
+//! `aligned-gbm`'s variants instead, with a sixth `1` to `11` for the first to eleventh round
+//! of them (8 to 11: `aligned-mlp`'s); the split is `--split by-user`,
 //! `--train-fraction 0.3`, `--seed 0`, the evaluation `--history 20 --horizon 5`.)
 
 use trajpred::dataset::{Dataset, Segmentation, load};
@@ -185,6 +185,24 @@ fn main() -> Result<()> {
                 };
                 mlp(&format!("aligned-mlp {members} members"), p)?;
             }
+        } else if arg(6, "1") == "11" {
+            // training tracks thinned to every other fix (both phases) as extra training
+            // origins, split where the thinned fixes are more than `max_gap` apart
+            let mlp = |name: &str, thin: bool| -> Result<()> {
+                report(name, &|| {
+                    let inner = AlignedMlp::new(AlignedMlpParams {
+                        members: 1,
+                        ..Default::default()
+                    })?;
+                    Ok(Box::new(Thinned {
+                        inner,
+                        thin,
+                        max_gap,
+                    }) as Box<dyn Predictor>)
+                })
+            };
+            mlp("aligned-mlp one network (wrapper, no thinning)", false)?;
+            mlp("aligned-mlp one network, thinned copies added", true)?;
         } else if arg(6, "1") == "10" {
             let one = |f: &dyn Fn(&mut AlignedMlpParams)| {
                 let mut p = AlignedMlpParams {
@@ -316,4 +334,59 @@ fn main() -> Result<()> {
         })?;
     }
     Ok(())
+}
+
+/// A throwaway wrapper for round 11: fits `inner` on the tracks plus, with `thin`, each track
+/// thinned to every other fix (both phases), split where those fixes are more than
+/// `max_gap` apart.
+struct Thinned {
+    inner: AlignedMlp,
+    thin: bool,
+    max_gap: f64,
+}
+
+impl Predictor for Thinned {
+    fn name(&self) -> &str {
+        "thinned"
+    }
+    fn fit(&mut self, train: &[Trajectory]) -> Result<()> {
+        let mut all = train.to_vec();
+        if self.thin {
+            for tr in train {
+                for phase in 0..2 {
+                    let idx: Vec<usize> = (phase..tr.len()).step_by(2).collect();
+                    let mut start = 0;
+                    for k in 1..=idx.len() {
+                        let cut = k == idx.len()
+                            || tr.times()[idx[k]] - tr.times()[idx[k - 1]] > self.max_gap;
+                        if cut {
+                            if k - start >= 25 {
+                                let times = idx[start..k].iter().map(|&i| tr.times()[i]).collect();
+                                let axes = tr
+                                    .axes()
+                                    .map(|a| idx[start..k].iter().map(|&i| a[i]).collect())
+                                    .collect();
+                                all.push(Trajectory::from_axes(times, axes)?);
+                            }
+                            start = k;
+                        }
+                    }
+                }
+            }
+        }
+        self.inner.fit(&all)
+    }
+    fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<trajpred_core::Forecast> {
+        self.inner.forecast(history, horizon)
+    }
+    fn forecast_times(
+        &self,
+        history: &Trajectory,
+        times: &[f64],
+    ) -> Result<trajpred_core::Forecast> {
+        self.inner.forecast_times(history, times)
+    }
+    fn min_history(&self) -> usize {
+        self.inner.min_history()
+    }
 }
