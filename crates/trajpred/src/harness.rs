@@ -416,7 +416,8 @@ fn check_fraction(f: f64) -> Result<()> {
 }
 
 /// Splits trajectories into (train, test). Parts too short to form a trajectory are left
-/// out. With [`Split::ByGroup`] every trajectory is its own group.
+/// out, and so are exact repeats ([`drop_repeats`]). With [`Split::ByGroup`] every
+/// trajectory is its own group.
 pub fn split(
     trajectories: &[Trajectory],
     how: Split,
