@@ -596,3 +596,36 @@ fn aligned_ridge_and_auto_name_what_does_not_fit_their_options() {
         other => panic!("expected InvalidFitted, got {other:?}"),
     }
 }
+
+#[test]
+fn a_fit_records_the_repeats_it_left_out_and_older_files_without_the_count_load() {
+    // segments 0..10, then two copies of each under other groups and ids
+    let mut segs = segments();
+    for k in 0..2 {
+        for i in 0..10 {
+            let mut copy = segment(i);
+            copy.group = format!("copy{k}-{i}");
+            copy.id = format!("copy{k}-{i}");
+            segs.push(copy);
+        }
+    }
+    let p = protocol_of(&["cv-time"]);
+    let (train, test, r) = protocol::split_counted(&p, &segs).expect("split");
+    assert_eq!(train.len() + test.len(), 10, "{r:?}");
+    assert_eq!(r.total(), 20, "{r:?}");
+    assert!(r.train > 0, "{r:?}");
+    let file = params::fit(&p, "data".as_ref(), &segs, &Silent).expect("fit");
+    assert_eq!(file.fitted_on.repeated_train_segments, r.train);
+    assert_eq!(file.fitted_on.train_segments, train.len());
+    assert_eq!(reload(&file).fitted_on, file.fitted_on);
+    // a file written before the count existed reads it as 0
+    let old = load_edited(|v| {
+        v["fitted_on"]
+            .as_object_mut()
+            .expect("object")
+            .remove("repeated_train_segments")
+            .expect("the field is written");
+    })
+    .expect("an older file loads");
+    assert_eq!(old.fitted_on.repeated_train_segments, 0);
+}
