@@ -459,10 +459,10 @@ pub fn split_segments_counted(
 pub struct Repeats {
     /// Training segments equal to an earlier training segment.
     pub train: usize,
-    /// Test segments equal to a training segment: kept, they would test the methods on
-    /// data they were fitted on.
+    /// Test segments equal to a training segment (left out: they would test the methods on
+    /// data they were fitted on).
     pub test_of_train: usize,
-    /// Test segments equal to an earlier test segment: kept, they would count twice.
+    /// Test segments equal to an earlier test segment (left out: they would count twice).
     pub test: usize,
 }
 

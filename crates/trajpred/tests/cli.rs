@@ -275,3 +275,48 @@ fn bad_input_gives_one_clear_line_and_a_failure_code() {
     let out = run(&["evaluate", "--dataset", "csv"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn evaluate_says_how_many_repeated_segments_it_left_out() {
+    let dir = scratch("repeats");
+    // three users' tracks, then a fourth file that copies the first byte for byte
+    let a = write_track(&dir, "a.csv", 60, 0.0);
+    write_track(&dir, "b.csv", 60, 1.0);
+    write_track(&dir, "c.csv", 60, 2.0);
+    let evaluate = |path: &std::path::Path| {
+        run_ok(&[
+            "evaluate",
+            "--dataset",
+            "csv",
+            "--path",
+            path.to_str().unwrap(),
+            "--methods",
+            "cv-time",
+            "--history",
+            "10",
+            "--horizon",
+            "3",
+            "--split",
+            "by-track",
+            "--train-fraction",
+            "0.5",
+        ])
+    };
+    let stderr = String::from_utf8(evaluate(&dir).stderr).unwrap();
+    assert!(!stderr.contains("exact repeats"), "{stderr}");
+    std::fs::copy(&a, dir.join("d.csv")).unwrap();
+    let stderr = String::from_utf8(evaluate(&dir).stderr).unwrap();
+    // wherever the split puts the two copies, one of them is left out and counted
+    let line = stderr
+        .lines()
+        .find(|l| l.contains("training and"))
+        .unwrap_or_else(|| panic!("{stderr}"));
+    let counts: Vec<usize> = line
+        .split("left out as exact repeats of other segments: ")
+        .nth(1)
+        .unwrap_or_else(|| panic!("{line}"))
+        .split(", ")
+        .map(|c| c.split(' ').next().unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(counts.iter().sum::<usize>(), 1, "{line}");
+}

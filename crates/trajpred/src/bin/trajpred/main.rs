@@ -334,7 +334,6 @@ fn say_skips(loaded: &Loaded) {
     }
 }
 
-/// Tells on stderr what each fitted method chose (`auto`'s pick and fold scores, ...).
 /// What the split left out as exact repeats ([`trajpred::harness::drop_repeats`]), for the
 /// line that counts the segments; empty when nothing was.
 fn repeats_note(r: &trajpred::harness::Repeats) -> String {
@@ -348,6 +347,7 @@ fn repeats_note(r: &trajpred::harness::Repeats) -> String {
     )
 }
 
+/// Tells on stderr what each fitted method chose (`auto`'s pick and fold scores, ...).
 fn say_fitted(run: &protocol::ProtocolRun) {
     for (label, p) in run.labels.iter().zip(&run.predictors) {
         if let Some(s) = p.fitted_summary() {
