@@ -483,10 +483,16 @@ pub(crate) fn backward(rows: Tri<'_>, z: &mut [f64]) {
 }
 
 mod dots2;
+mod dots32;
 mod gram;
+mod screen_bounds;
 pub(crate) mod step;
 pub(crate) use dots2::dots2;
+pub(crate) use dots32::dots32;
 pub(crate) use gram::gram;
+pub(crate) use screen_bounds::screen_bounds;
+#[cfg(test)]
+pub(crate) use screen_bounds::screen_bounds_plain;
 pub(crate) use step::step_min;
 
 #[cfg(test)]

@@ -171,3 +171,34 @@ fn two_vector_dots_equal_two_single_passes_bit_for_bit() {
         assert_eq!(bits(&got2), bits(&want2), "v2 {n}x{p} ld {ld}");
     }
 }
+
+#[test]
+fn screen_bounds_kernel_equals_the_plain_loop() {
+    // lengths around the vector widths; exact and uncertain terms, signs and zeros
+    for len in [0usize, 1, 3, 5, 8, 9, 17, 64, 1001] {
+        let c: Vec<f64> = (0..len)
+            .map(|k| match k % 11 {
+                0 => 0.0,
+                5 => 2.0,
+                7 => -3.0,
+                _ => ((k * 37 % 101) as f64 - 50.0) / 30.0,
+            })
+            .collect();
+        let a: Vec<f64> = (0..len)
+            .map(|k| match k % 13 {
+                3 => 1.5,
+                _ => ((k * 53 % 97) as f64 - 48.0) / 20.0,
+            })
+            .collect();
+        let e: Vec<f64> = (0..len).map(|k| [0.0, 1e-6, 0.3][k % 3]).collect();
+        let b: Vec<f64> = (0..len).map(|k| [1e-5, 0.0, 0.2, 2.0][k % 4]).collect();
+        for &(big_c, aa, gamma_hat) in &[(2.0, 1.5, 2.0 / 1.5), (2.0, 0.25, 8.0)] {
+            let (mut lo, mut lo_plain) = (vec![f64::NAN; len], vec![f64::NAN; len]);
+            let got = screen_bounds((&c, &a, &e, &b), (big_c, aa, gamma_hat), &mut lo);
+            let want = screen_bounds_plain((&c, &a, &e, &b), (big_c, aa, gamma_hat), &mut lo_plain);
+            assert_eq!(got.to_bits(), want.to_bits(), "len {len} C {big_c} AA {aa}");
+            let bits = |s: &[f64]| s.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&lo), bits(&lo_plain), "len {len} C {big_c} AA {aa}");
+        }
+    }
+}

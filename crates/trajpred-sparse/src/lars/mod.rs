@@ -9,6 +9,7 @@
 mod fitted;
 mod knots;
 mod path;
+mod screen;
 mod sklearn;
 
 pub use fitted::Lars;
@@ -141,6 +142,12 @@ pub struct LarsParams {
     collinearity_tolerance: f64,
     vanish_tolerance: f64,
     gram: Gram,
+    #[serde(default = "screen_default")]
+    screen: bool,
+}
+
+fn screen_default() -> bool {
+    true
 }
 
 impl Default for LarsParams {
@@ -155,6 +162,7 @@ impl Default for LarsParams {
             collinearity_tolerance: 1e-12,
             vanish_tolerance: 1e-12,
             gram: Gram::Auto,
+            screen: true,
         }
     }
 }
@@ -188,6 +196,12 @@ impl LarsParams {
         vanish_tolerance(tol: f64) => self.vanish_tolerance = tol;
         /// Gram matrix policy (speed only; the path is the same up to rounding).
         gram(gram: Gram) => self.gram = gram;
+        /// On a wide LAR path without the Gram matrix (`p > n`), read a single-precision copy
+        /// of `X` in each step's pass and take again in double precision only the columns
+        /// whose step length its error bounds cannot rule out (speed only: the same
+        /// variables enter at the same steps, and the path agrees to rounding). Default
+        /// `true`.
+        screen(yes: bool) => self.screen = yes;
     }
 
     fn validate(&self) -> Result<()> {

@@ -2,6 +2,7 @@
 //! updated Cholesky factor, with or without the Gram matrix, and the final refinement.
 
 use super::knots::Knots;
+use super::screen::Screen;
 use super::{Exclusion, ExclusionReason, LarsParams, Method, PathEvent, StopReason};
 use crate::cholesky::{Append, CholeskyFactor};
 use crate::kernels::{self, dot};
@@ -60,6 +61,9 @@ pub(super) struct Core<'a> {
     /// Without the Gram matrix, on a LAR path: `x_a . x_j` saved for the active variables
     /// `a` and the columns `j` still inactive (see [`Saved`]).
     saved: Saved,
+    /// Without the Gram matrix, on a wide LAR path: the single-precision screen of the pass
+    /// over `X` (see [`Screen`]).
+    screen: Option<Screen>,
 }
 
 /// The products of each active variable with the columns inactive when it entered, taken in
@@ -134,6 +138,7 @@ impl<'a> Core<'a> {
                 have: 0,
                 new: Vec::new(),
             },
+            screen: None,
         }
     }
 
@@ -216,7 +221,13 @@ impl<'a> Core<'a> {
                     self.order.extend_from_slice(&self.inactive);
                 }
                 let k = active.len();
-                if self.saved.on && k == self.saved.have + 1 && self.saved.have < self.saved.cap {
+                if let Some(screen) = self.screen.as_mut() {
+                    // approximate products; the step length takes the ones that matter again
+                    screen.pass(&self.order, &self.u, &mut self.a_inactive);
+                } else if self.saved.on
+                    && k == self.saved.have + 1
+                    && self.saved.have < self.saved.cap
+                {
                     // the variable that entered last: its products with the inactive columns
                     // from the same pass, for when one of them enters
                     let f = active[self.saved.have];
@@ -319,7 +330,12 @@ impl<'a> Core<'a> {
         self.inactive.clear();
         self.inactive.extend((0..p).filter(|&j| eligible[j]));
         let cap = self.n.min(p);
+        if self.gram.is_none() && params.method == Method::Lar && p > self.n && params.screen {
+            let data = design(self.xs, &self.xcopy);
+            self.screen = Screen::new(data, self.ldx, (self.n, p), ys, SCREEN_BYTES);
+        }
         if self.gram.is_none()
+            && self.screen.is_none()
             && params.method == Method::Lar
             && p * cap * size_of::<f64>() <= SAVED_BYTES
         {
@@ -401,6 +417,10 @@ impl<'a> Core<'a> {
 
             // --- variables that tie for the largest correlation enter -------------------------
             let threshold = big_c * (1.0 - params.tie_tolerance);
+            if let Some(screen) = self.screen.as_mut() {
+                let data = design(self.xs, &self.xcopy);
+                screen.refresh_near(data, self.ldx, &self.inactive, &mut c, threshold);
+            }
             candidates.clear();
             candidates.extend(
                 self.inactive
@@ -484,7 +504,17 @@ impl<'a> Core<'a> {
             } else {
                 &[]
             };
-            if !listed.is_empty() {
+            if let (Some(screen), false) = (self.screen.as_mut(), listed.is_empty()) {
+                let data = design(self.xs, &self.xcopy);
+                gamma = screen.step(
+                    (data, self.ldx),
+                    listed,
+                    &self.a_inactive,
+                    &self.u,
+                    (&mut c, &mut a),
+                    (big_c, aa, gamma_hat),
+                );
+            } else if !listed.is_empty() {
                 c_listed.clear();
                 c_listed.extend(listed.iter().map(|&j| c[j]));
                 gamma = kernels::step_min(&c_listed, &self.a_inactive, big_c, aa, gamma_hat);
@@ -548,6 +578,9 @@ impl<'a> Core<'a> {
             for (cj, aj) in c.iter_mut().zip(&a) {
                 *cj -= gamma * aj;
             }
+            if let Some(screen) = self.screen.as_mut() {
+                screen.moved(&self.order, gamma, &self.u);
+            }
             big_c = if full_step {
                 0.0
             } else {
@@ -597,6 +630,9 @@ impl<'a> Core<'a> {
         }
     }
 }
+
+/// Largest single-precision copy of `X` a [`Screen`] makes (bytes).
+const SCREEN_BYTES: usize = 16 << 20;
 
 /// Largest design copied by [`aligned_copy`] (bytes): the copy is kept for the next fit (see
 /// [`crate::workspace`]), whose pool keeps at most 32 MiB.
