@@ -7,8 +7,10 @@
 //! cargo run --release -p trajpred --example tune_by_user -- geolife ../shared/data/geolife 5 55
 //! ```
 //! (dataset, path, `--max-gap`, `--min-points`; a fifth argument `gbm` scores
-//! `aligned-gbm`'s variants instead, with a sixth `1` to `11` for the first to eleventh round
-//! of them (8 to 11: `aligned-mlp`'s); the split is `--split by-user`,
+//! `aligned-gbm`'s variants instead, with a sixth `1` to `13` for the first to thirteenth
+//! round of them (8 to 11: `aligned-mlp`'s; 12: the mean of the two learners; 13, with a
+//! seventh naming a method, default `cv-time`: that method with its own recent errors fed
+//! back); the split is `--split by-user`,
 //! `--train-fraction 0.3`, `--seed 0`, the evaluation `--history 20 --horizon 5`.)
 
 use trajpred::dataset::{Dataset, Segmentation, load};
@@ -203,6 +205,24 @@ fn main() -> Result<()> {
             };
             mlp("aligned-mlp one network (wrapper, no thinning)", false)?;
             mlp("aligned-mlp one network, thinned copies added", true)?;
+        } else if arg(6, "1") == "12" {
+            // the plain mean of the two learners' forecasts, every step weighing them equally
+            report("mean of aligned-gbm and aligned-mlp", &|| {
+                Ok(Box::new(MeanOf {
+                    members: vec![build("aligned-gbm", &opts)?, build("aligned-mlp", &opts)?],
+                }) as Box<dyn Predictor>)
+            })?;
+        } else if arg(6, "1") == "13" {
+            // the inner method's own recent errors, read inside the history, fed back
+            let inner = arg(7, "cv-time");
+            for alpha in [0.0, 0.25, 0.5, 1.0] {
+                report(&format!("{inner} with feedback {alpha}"), &|| {
+                    Ok(Box::new(Feedback {
+                        inner: build(&inner, &opts)?,
+                        alpha,
+                    }) as Box<dyn Predictor>)
+                })?;
+            }
         } else if arg(6, "1") == "10" {
             let one = |f: &dyn Fn(&mut AlignedMlpParams)| {
                 let mut p = AlignedMlpParams {
@@ -385,6 +405,164 @@ impl Predictor for Thinned {
         times: &[f64],
     ) -> Result<trajpred_core::Forecast> {
         self.inner.forecast_times(history, times)
+    }
+    fn min_history(&self) -> usize {
+        self.inner.min_history()
+    }
+}
+
+/// A throwaway wrapper for round 12: the plain mean of its members' forecasts.
+struct MeanOf {
+    members: Vec<Box<dyn Predictor>>,
+}
+
+impl MeanOf {
+    fn mean(
+        &self,
+        f: &dyn Fn(&dyn Predictor) -> Result<trajpred_core::Forecast>,
+    ) -> Result<trajpred_core::Forecast> {
+        let got: Vec<_> = self
+            .members
+            .iter()
+            .map(|m| f(m.as_ref()))
+            .collect::<Result<_>>()?;
+        let n = got.len() as f64;
+        let steps: Vec<Vec<f64>> = (1..=got[0].horizon())
+            .map(|k| {
+                (0..got[0].dim())
+                    .map(|a| got.iter().map(|g| g.step(k)[a]).sum::<f64>() / n)
+                    .collect()
+            })
+            .collect();
+        trajpred_core::Forecast::new(got[0].dim(), steps)
+    }
+}
+
+impl Predictor for MeanOf {
+    fn name(&self) -> &str {
+        "mean-of"
+    }
+    fn fit(&mut self, train: &[Trajectory]) -> Result<()> {
+        self.members.iter_mut().try_for_each(|m| m.fit(train))
+    }
+    fn fit_grouped(&mut self, train: &[Trajectory], groups: &[usize]) -> Result<()> {
+        self.members
+            .iter_mut()
+            .try_for_each(|m| m.fit_grouped(train, groups))
+    }
+    fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<trajpred_core::Forecast> {
+        self.mean(&|m| m.forecast(history, horizon))
+    }
+    fn forecast_times(
+        &self,
+        history: &Trajectory,
+        times: &[f64],
+    ) -> Result<trajpred_core::Forecast> {
+        self.mean(&|m| m.forecast_times(history, times))
+    }
+    fn min_history(&self) -> usize {
+        self.members
+            .iter()
+            .map(|m| m.min_history())
+            .max()
+            .unwrap_or(1)
+    }
+}
+
+/// A throwaway wrapper for round 13: the inner forecast plus `alpha` times the mean of the
+/// inner method's errors on the earlier origins of the same history (each error at step `k`
+/// measured in the frame of its origin's last leg, turned into the frame of the history's
+/// last leg).
+struct Feedback {
+    inner: Box<dyn Predictor>,
+    alpha: f64,
+}
+
+/// The unit vector along the leg ending at `o`, if it has a length.
+fn heading(tr: &Trajectory, o: usize) -> Option<[f64; 2]> {
+    let (a, b) = (tr.point(o), tr.point(o - 1));
+    let (dx, dy) = (a.as_ref()[0] - b.as_ref()[0], a.as_ref()[1] - b.as_ref()[1]);
+    let n = dx.hypot(dy);
+    (n > 1e-9).then(|| [dx / n, dy / n])
+}
+
+impl Feedback {
+    fn corrected(&self, history: &Trajectory, times: &[f64]) -> Result<trajpred_core::Forecast> {
+        let f = self.inner.forecast_times(history, times)?;
+        let n = history.len();
+        if n < 2 {
+            return Ok(f);
+        }
+        let last = n - 1;
+        let Some(u) = heading(history, last) else {
+            return Ok(f);
+        };
+        let mut steps = Vec::with_capacity(times.len());
+        for k in 1..=times.len() {
+            // along and across errors at step k, summed over the earlier origins
+            let (mut sa, mut sc, mut m) = (0.0, 0.0, 0usize);
+            if self.alpha > 0.0 {
+                let lo = self.inner.min_history().max(2) - 1;
+                for o in lo..last.saturating_sub(k - 1) {
+                    if o + k > last {
+                        break;
+                    }
+                    let Some(v) = heading(history, o) else {
+                        continue;
+                    };
+                    let sub = history.prefix(o + 1)?;
+                    let ts: Vec<f64> = (1..=k).map(|j| history.times()[o + j]).collect();
+                    let Ok(g) = self.inner.forecast_times(&sub, &ts) else {
+                        continue;
+                    };
+                    let p = g.step(k);
+                    let t = history.point(o + k);
+                    let (ex, ey) = (t.as_ref()[0] - p[0], t.as_ref()[1] - p[1]);
+                    sa += ex * v[0] + ey * v[1];
+                    sc += -ex * v[1] + ey * v[0];
+                    m += 1;
+                }
+            }
+            let p = f.step(k);
+            if m == 0 {
+                steps.push(p.to_vec());
+                continue;
+            }
+            let (a, c) = (self.alpha * sa / m as f64, self.alpha * sc / m as f64);
+            let mut q = p.to_vec();
+            q[0] += a * u[0] - c * u[1];
+            q[1] += a * u[1] + c * u[0];
+            steps.push(q);
+        }
+        trajpred_core::Forecast::new(f.dim(), steps)
+    }
+}
+
+impl Predictor for Feedback {
+    fn name(&self) -> &str {
+        "feedback"
+    }
+    fn fit(&mut self, train: &[Trajectory]) -> Result<()> {
+        self.inner.fit(train)
+    }
+    fn fit_grouped(&mut self, train: &[Trajectory], groups: &[usize]) -> Result<()> {
+        self.inner.fit_grouped(train, groups)
+    }
+    fn forecast(&self, history: &Trajectory, horizon: usize) -> Result<trajpred_core::Forecast> {
+        if history.len() < 2 {
+            return self.inner.forecast(history, horizon);
+        }
+        let dt = history.times()[history.len() - 1] - history.times()[history.len() - 2];
+        let t0 = history.times()[history.len() - 1];
+        let ts: Vec<f64> = (1..=horizon).map(|k| t0 + k as f64 * dt).collect();
+        self.corrected(history, &ts)
+    }
+    fn forecast_times(
+        &self,
+        history: &Trajectory,
+        times: &[f64],
+    ) -> Result<trajpred_core::Forecast> {
+        self.corrected(history, times)
     }
     fn min_history(&self) -> usize {
         self.inner.min_history()
