@@ -159,3 +159,17 @@ fn the_lasso_and_tall_designs_are_not_screened_and_unchanged() {
     assert_eq!(a.coef_path(), b.coef_path());
     assert_eq!(a.events(), b.events());
 }
+
+#[test]
+fn extreme_scales_keep_the_unscreened_path() {
+    // unscaled columns of 1e-40 to 1e35: single precision underflows or overflows at the
+    // ends (beyond 1e30 the screen is not used); every path must stay the plain one
+    let (x, y) = design(40, 200, 1.0, 5, 9);
+    for s in [1e-40, 1e-30, 1e-15, 1e15, 1e29, 1e35] {
+        let xs = &x * s;
+        let params = Lars::params().fit_intercept(false).normalize(false);
+        let reference = with_gram(params.clone(), &xs, &y);
+        let (a, b) = both(params, &xs, &y);
+        assert_same_path(&a, &b, &reference, &format!("scale {s:e}"));
+    }
+}
