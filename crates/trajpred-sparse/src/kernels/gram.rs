@@ -11,8 +11,11 @@ use pulp::{Simd, WithSimd};
 /// `3 + L` loads per `3 L` fused multiply-adds. (128, 256 and 512 rows ran equally fast on
 /// 5000 x 500.)
 const GRAM_ROWS: usize = 256;
-/// Vectors of features per row block of the micro-kernel.
-const GRAM_MV: usize = 3;
+/// Vectors of features per row block of the micro-kernel: three with AVX-512's 32 registers,
+/// two with AVX2's 16 (three take all 16 with the accumulators, and the compiler spills).
+fn gram_mv(lanes: usize) -> usize {
+    if lanes >= 8 { 3 } else { 2 }
+}
 
 struct GramPacked<'a> {
     data: &'a [f64],
@@ -42,19 +45,20 @@ fn gram_micro<S: Simd, const M: usize, const NR: usize>(
     let mut arows: [&[S::f64s]; M] = [&[]; M];
     for (v, a) in arows.iter_mut().enumerate() {
         let o = (ib + v) * block;
-        *a = S::as_simd_f64s(&t[o..o + len * l]).0;
+        // exactly `len` vectors, so that the loop below needs no bounds check
+        *a = &S::as_simd_f64s(&t[o..o + len * l]).0[..len];
     }
     let o = jb * block;
-    let brows = &t[o..o + len * l];
+    let brows = &t[o..o + len * NR];
     let z = simd.splat_f64s(0.0);
     let mut acc = [[z; NR]; M];
-    for (r, bchunk) in brows.chunks_exact(NR).enumerate() {
+    for r in 0..len {
         let mut av = [z; M];
         for v in 0..M {
             av[v] = arows[v][r];
         }
         for b in 0..NR {
-            let bb = simd.splat_f64s(bchunk[b]);
+            let bb = simd.splat_f64s(brows[r * NR + b]);
             for v in 0..M {
                 acc[v][b] = simd.mul_add_e_f64s(av[v], bb, acc[v][b]);
             }
@@ -124,7 +128,7 @@ fn gram_chunks<S: Simd, const NR: usize>(simd: S, job: GramPacked<'_>) {
         }
         let mut ib = 0;
         while ib < nblocks {
-            let m = GRAM_MV.min(nblocks - ib);
+            let m = gram_mv(l).min(nblocks - ib);
             for jb in ib..nblocks {
                 let (blocks, dims) = ((ib, jb), (pe, pl));
                 // the upper block triangle only: column block `jb` needs the row blocks up to

@@ -26,6 +26,7 @@ fn kernels_agree_with_plain_loops_on_awkward_sizes() {
         (64, 4),
         (515, 7),
         (1030, 13),
+        (300, 29),
     ] {
         let x = matrix(n, p);
         let v: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
