@@ -17,6 +17,12 @@ use clap::builder::{PossibleValuesParser, TypedValueParser};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+/// The reproduction's neural training allocates and frees a tensor per operation (burn's
+/// ops return new tensors): mimalloc serves that churn with less work than glibc's malloc
+/// (kfu-lstm alone, docs/performance.md: about 0.75x the time).
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 use trajpred_repro::{
     Context, Paper, ReproError, bless, check_paper, run_info, run_papers, write_run,
 };
