@@ -10,6 +10,7 @@ use super::fitted::{At, exact, exact_vec};
 use super::invalid;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use trajpred_core::{Error, Forecast, Predictor, Result, Trajectory, check_forecast_args};
 
@@ -218,6 +219,39 @@ fn nearest(c: &[Vec<f64>], x: &[f64]) -> usize {
     best.0
 }
 
+/// Points per rayon task of [`assign_nearest`] (below it one task: its results are the same).
+const ASSIGN_CHUNK: usize = 4096;
+
+/// Assigns each point of `flat` (`dim` values a point) to its nearest centroid of `cflat`
+/// (the first of equals, as [`nearest`]), in parallel over chunks of points; returns whether
+/// any assignment changed.
+fn assign_nearest(flat: &[f64], cflat: &[f64], dim: usize, assign: &mut [usize]) -> bool {
+    let near = |x: &[f64]| {
+        let mut best = (0, f64::INFINITY);
+        for (j, c) in cflat.chunks_exact(dim).enumerate() {
+            let d = sq_dist(c, x);
+            if d < best.1 {
+                best = (j, d);
+            }
+        }
+        best.0
+    };
+    let pass = |(a, x): (&mut [usize], &[f64])| {
+        let mut changed = false;
+        for (a, x) in a.iter_mut().zip(x.chunks_exact(dim)) {
+            let j = near(x);
+            changed |= *a != j;
+            *a = j;
+        }
+        changed
+    };
+    assign
+        .par_chunks_mut(ASSIGN_CHUNK)
+        .zip(flat.par_chunks(ASSIGN_CHUNK * dim))
+        .map(pass)
+        .reduce(|| false, |a, b| a | b)
+}
+
 /// k-means with k-means++ seeding (seeded), Lloyd iterations; an emptied cluster is re-seeded
 /// with the point farthest from its centroid.
 fn kmeans(data: &[Vec<f64>], k: usize, seed: u64, max_iter: usize) -> Vec<Vec<f64>> {
@@ -246,14 +280,13 @@ fn kmeans(data: &[Vec<f64>], k: usize, seed: u64, max_iter: usize) -> Vec<Vec<f6
         }
     }
     let dim = data[0].len();
+    // the points and centroids flat (row after row), so that a Lloyd pass reads contiguous
+    // memory; the distances are summed as in `sq_dist`, so the assignments are the same
+    let flat: Vec<f64> = data.iter().flatten().copied().collect();
     let mut assign = vec![usize::MAX; data.len()];
     for _ in 0..max_iter {
-        let mut changed = false;
-        for (a, x) in assign.iter_mut().zip(data) {
-            let j = nearest(&centroids, x);
-            changed |= *a != j;
-            *a = j;
-        }
+        let cflat: Vec<f64> = centroids.iter().flatten().copied().collect();
+        let changed = assign_nearest(&flat, &cflat, dim, &mut assign);
         if !changed {
             break;
         }
@@ -333,18 +366,49 @@ fn train(seqs: &[Vec<Vec<f64>>], k: usize, params: &HmmParams) -> Result<HmmMode
     })
 }
 
+/// `dist` pushed through the transition matrix, `out[j] = sum_i dist[i] T[i][j]`, from the
+/// transposed matrix `tt` (row `j` holds column `j` of `T`, `k` values a row). Each `out[j]`
+/// is one sum over `i` in order, exactly as a plain `.sum()` would form it; four of them run
+/// side by side, so that the additions of one do not wait for those of the others.
+fn push_through(tt: &[f64], dist: &[f64]) -> Vec<f64> {
+    let k = dist.len();
+    let mut out = vec![0.0; k];
+    let mut rows = tt.chunks_exact(k);
+    let mut outs = out.chunks_exact_mut(4);
+    for o in &mut outs {
+        let r: [&[f64]; 4] = std::array::from_fn(|_| rows.next().unwrap_or(&[]));
+        let mut acc = [-0.0f64; 4];
+        for (i, &p) in dist.iter().enumerate() {
+            for (a, r) in acc.iter_mut().zip(&r) {
+                *a += p * r[i];
+            }
+        }
+        o.copy_from_slice(&acc);
+    }
+    for (o, r) in outs.into_remainder().iter_mut().zip(rows) {
+        *o = dist.iter().zip(r).map(|(p, t)| p * t).sum();
+    }
+    out
+}
+
 impl HmmModel {
+    /// The transition matrix transposed, flat: row `j` is column `j` of `transition`.
+    fn transposed(&self) -> Vec<f64> {
+        let k = self.transition.len();
+        (0..k)
+            .flat_map(|j| self.transition.iter().map(move |row| row[j]))
+            .collect()
+    }
+
     /// Forward-filtered distribution of the state of the last displacement.
     fn filter(&self, disp: &[Vec<f64>]) -> Vec<f64> {
-        let k = self.centroids.len();
+        let tt = self.transposed();
         let mut alpha = self.initial.clone();
         for (t, d) in disp.iter().enumerate() {
             let prior: Vec<f64> = if t == 0 {
                 self.initial.clone()
             } else {
-                (0..k)
-                    .map(|j| (0..k).map(|i| alpha[i] * self.transition[i][j]).sum())
-                    .collect()
+                push_through(&tt, &alpha)
             };
             let log_e: Vec<f64> = self
                 .centroids
@@ -371,11 +435,10 @@ impl HmmModel {
     /// Expected displacements of the next `horizon` steps, given the filtered distribution.
     fn expected_displacements(&self, mut dist: Vec<f64>, horizon: usize) -> Vec<Vec<f64>> {
         let k = self.centroids.len();
+        let tt = self.transposed();
         (0..horizon)
             .map(|_| {
-                dist = (0..k)
-                    .map(|j| (0..k).map(|i| dist[i] * self.transition[i][j]).sum())
-                    .collect();
+                dist = push_through(&tt, &dist);
                 (0..self.dim)
                     .map(|a| (0..k).map(|j| dist[j] * self.centroids[j][a]).sum())
                     .collect()
@@ -534,20 +597,31 @@ fn choose_k(seqs: &[Vec<Vec<f64>>], params: &HmmParams) -> Result<usize> {
             continue;
         }
         let model = train(&fit, k, params)?;
+        // each origin's step errors in parallel, then summed in the origins' order
+        let chosen: Vec<(usize, usize)> = origins.iter().step_by(stride).copied().collect();
+        let per_origin: Vec<Vec<f64>> = chosen
+            .par_iter()
+            .map(|&(i, j)| {
+                let seq = &held[i];
+                let recent = &seq[j.saturating_sub(params.filter_window)..j];
+                let pred = model.expected_displacements(model.filter(recent), h);
+                let (mut p, mut t) = (vec![0.0; model.dim], vec![0.0; model.dim]);
+                pred.iter()
+                    .zip(&seq[j..j + h])
+                    .map(|(step, d)| {
+                        for a in 0..model.dim {
+                            p[a] += step[a];
+                            t[a] += d[a];
+                        }
+                        sq_dist(&p, &t).sqrt()
+                    })
+                    .collect()
+            })
+            .collect();
         let (mut err, mut n) = (0.0, 0usize);
-        for &(i, j) in origins.iter().step_by(stride) {
-            let seq = &held[i];
-            let recent = &seq[j.saturating_sub(params.filter_window)..j];
-            let pred = model.expected_displacements(model.filter(recent), h);
-            let (mut p, mut t) = (vec![0.0; model.dim], vec![0.0; model.dim]);
-            for (step, d) in pred.iter().zip(&seq[j..j + h]) {
-                for a in 0..model.dim {
-                    p[a] += step[a];
-                    t[a] += d[a];
-                }
-                err += sq_dist(&p, &t).sqrt();
-                n += 1;
-            }
+        for e in per_origin.iter().flatten() {
+            err += e;
+            n += 1;
         }
         let score = if n > 0 { err / n as f64 } else { f64::INFINITY };
         if best.is_none_or(|(_, s)| score < s) {
@@ -559,4 +633,71 @@ fn choose_k(seqs: &[Vec<Vec<f64>>], params: &HmmParams) -> Result<usize> {
         needed: params.candidates.iter().copied().min().unwrap_or(1),
         got: total_fit,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A pseudo-random row-stochastic matrix and distribution of `k` states (no RNG crate:
+    /// a fixed sine sequence).
+    fn model(k: usize) -> HmmModel {
+        let v = |i: usize| ((i as f64 * 12.9898).sin() * 43758.5453).fract().abs() + 1e-3;
+        let transition = (0..k)
+            .map(|i| {
+                let row: Vec<f64> = (0..k).map(|j| v(i * k + j)).collect();
+                let s: f64 = row.iter().sum();
+                row.into_iter().map(|x| x / s).collect()
+            })
+            .collect();
+        HmmModel {
+            dim: 2,
+            centroids: (0..k).map(|j| vec![v(7 * j), -v(7 * j + 1)]).collect(),
+            transition,
+            initial: vec![1.0 / k as f64; k],
+            emission_variance: 0.3,
+        }
+    }
+
+    /// The transposed, four-chains product equals the plain column sums bit for bit (the
+    /// fit's choice of K and every forecast depend on it), at sizes around the chain count.
+    #[test]
+    fn push_through_is_the_plain_sum_bit_for_bit() {
+        for k in [1, 2, 3, 4, 5, 7, 8, 9, 33, 128] {
+            let m = model(k);
+            let dist: Vec<f64> = (0..k).map(|i| m.transition[k / 2][i]).collect();
+            let want: Vec<f64> = (0..k)
+                .map(|j| (0..k).map(|i| dist[i] * m.transition[i][j]).sum())
+                .collect();
+            let got = push_through(&m.transposed(), &dist);
+            assert_eq!(
+                got.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                want.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                "k = {k}"
+            );
+        }
+    }
+
+    /// The parallel, flat assignment step picks what `nearest` picks (the first of equal
+    /// distances included) and reports a change exactly when one happened, across several
+    /// rayon chunks.
+    #[test]
+    fn assign_nearest_matches_nearest() {
+        let m = model(9);
+        let mut cents = m.centroids.clone();
+        cents.push(cents[3].clone()); // an exact tie: the first index must win
+        let points: Vec<Vec<f64>> = (0..3 * ASSIGN_CHUNK + 17)
+            .map(|i| vec![((i as f64) * 0.37).sin(), ((i as f64) * 0.11).cos() - 0.5])
+            .collect();
+        let flat: Vec<f64> = points.iter().flatten().copied().collect();
+        let cflat: Vec<f64> = cents.iter().flatten().copied().collect();
+        let mut assign = vec![usize::MAX; points.len()];
+        assert!(assign_nearest(&flat, &cflat, 2, &mut assign));
+        let want: Vec<usize> = points.iter().map(|x| nearest(&cents, x)).collect();
+        assert_eq!(assign, want);
+        assert!(!assign.contains(&(cents.len() - 1)));
+        assert!(!assign_nearest(&flat, &cflat, 2, &mut assign));
+        assign[2 * ASSIGN_CHUNK + 5] = usize::MAX;
+        assert!(assign_nearest(&flat, &cflat, 2, &mut assign));
+    }
 }
