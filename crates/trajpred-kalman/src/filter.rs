@@ -7,8 +7,8 @@ use crate::driver::scan;
 use crate::error::Result;
 use crate::linalg::{
     Ldl, all_finite, check_dim, check_finite, check_square, check_state, congruence_ldl,
-    congruence_simd, congruence_simd_applies, is_static, joseph, ldl, mean_finite_and_symmetric,
-    mul, mul_tr_sym_plus, mul_vec, positive_definite_minors, symmetrise,
+    congruence_simd, congruence_simd_applies, congruence_simd_unchecked, is_static, joseph, ldl,
+    mean_finite_and_symmetric, mul, mul_tr_sym_plus, mul_vec, positive_definite_minors, symmetrise,
 };
 use crate::model::{LinearTransitionModel, Observation};
 use nalgebra::allocator::Allocator;
@@ -557,9 +557,14 @@ where
     validate_state(state, n, checks)?;
     check_dim("F rows", n, f.nrows())?;
     check_dim("F columns", n, f.ncols())?;
+    // without the factorisation (`InputChecks::Cheap`), the SIMD product still applies where
+    // the factorising path would have used it: the same covariance for a `P` that passes
+    let simd = (!factorise && is_static::<D, D>() && !tr.has_structured_propagation())
+        .then(|| congruence_simd_unchecked(f, &state.covariance, tr.process_noise()))
+        .flatten();
     Ok(Gaussian {
         mean: tr.propagate_mean(&state.mean),
-        covariance: tr.propagate_covariance(&state.covariance),
+        covariance: simd.unwrap_or_else(|| tr.propagate_covariance(&state.covariance)),
     })
 }
 

@@ -337,7 +337,9 @@ fn predict_accepts_and_rejects_p_at_every_scale() {
 fn dense6_predict_accepts_and_rejects_p_at_every_scale() {
     // the 6-state dense F (on machines with AVX2 or AVX-512, the SIMD `F P F^T` after the
     // leading-minors check): the same verdicts as the exact check at every scale, and the
-    // prediction equal to rounding to the one of the cheap path (scalar `F P F^T`)
+    // prediction equal to rounding to the one of the cheap path (the SIMD product without
+    // the check) and to nalgebra's `F P F^T + Q`; the cheap path, which does not verify
+    // definiteness, gives that product for the indefinite P too
     let mut rng = ChaCha8Rng::seed_from_u64(29);
     let v = SMatrix::<f64, 6, 6>::from_fn(|_, _| rng.sample::<f64, _>(StandardNormal))
         .qr()
@@ -366,13 +368,17 @@ fn dense6_predict_accepts_and_rejects_p_at_every_scale() {
                 covariance: p,
             };
             let r = kf.predict(&state);
+            let cheap = kf
+                .clone()
+                .with_input_checks(InputChecks::Cheap)
+                .predict(&state)
+                .unwrap();
+            let reference = f * p * f.transpose() + q;
+            let (size, diff) = (reference.amax(), (cheap.covariance - reference).amax());
+            assert!(diff <= 1e-12 * size, "cheap {eig:?} x {scale:e}: {diff:e}");
+            assert_eq!(cheap.covariance, cheap.covariance.transpose());
             if accept {
                 let pred = r.unwrap_or_else(|e| panic!("{eig:?} x {scale:e}: {e}"));
-                let cheap = kf
-                    .clone()
-                    .with_input_checks(InputChecks::Cheap)
-                    .predict(&state)
-                    .unwrap();
                 assert_eq!(pred.mean, cheap.mean);
                 assert_eq!(pred.covariance, pred.covariance.transpose());
                 let size = cheap.covariance.amax();

@@ -30,6 +30,8 @@ struct Congruence<'a, const N: usize> {
     p: &'a [f64],
     q: &'a [f64],
     out: &'a mut [f64],
+    /// whether to run the leading-minors check first (skipped: `P` is taken as it is)
+    check: bool,
 }
 
 impl<const N: usize> WithSimd for Congruence<'_, N> {
@@ -39,7 +41,13 @@ impl<const N: usize> WithSimd for Congruence<'_, N> {
 
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) -> Option<bool> {
-        let Congruence { f, p, q, out } = self;
+        let Congruence {
+            f,
+            p,
+            q,
+            out,
+            check,
+        } = self;
         let lanes = S::F64_LANES;
         let len = N * N;
         // scalar lanes: not worth it (the caller's loops are as good)
@@ -53,38 +61,7 @@ impl<const N: usize> WithSimd for Congruence<'_, N> {
         }
         let nv = N.div_ceil(lanes);
         let zero = simd.splat_f64s(0.0);
-        // the leading principal minors of P by fraction-free elimination on whole columns:
-        // the operations of `positive_definite_minors` in the same order (no fused
-        // multiply-adds), so the same verdict; the lanes above the diagonal and past a
-        // column's end are never read by the lanes below it
-        let mut a = [[zero; MAX_VECTORS]; N];
-        for j in 0..N {
-            for v in 0..nv {
-                a[j][v] = load(simd, p, j * N + v * lanes);
-            }
-        }
-        let big = f64::MAX;
-        let tiny = 1.0 / big;
-        let mut ok = true;
-        let mut inv_prev = 1.0;
-        let mut col = [0.0; 2 * 8];
-        for k in 0..N {
-            for v in 0..nv {
-                S::as_mut_simd_f64s(&mut col[v * lanes..(v + 1) * lanes]).0[0] = a[k][v];
-            }
-            let pk = col[k];
-            ok &= (pk >= tiny) & (pk <= big);
-            let (pv, iv) = (simd.splat_f64s(pk), simd.splat_f64s(inv_prev));
-            for j in (k + 1)..N {
-                let ajk = simd.splat_f64s(col[j]);
-                for v in 0..nv {
-                    let t = simd.sub_f64s(simd.mul_f64s(pv, a[j][v]), simd.mul_f64s(a[k][v], ajk));
-                    a[j][v] = simd.mul_f64s(t, iv);
-                }
-            }
-            inv_prev = 1.0 / pk;
-        }
-        if !ok {
+        if check && !leading_minors_positive::<S, N>(simd, p) {
             return Some(false);
         }
         let mut fc = [[zero; MAX_VECTORS]; N];
@@ -145,6 +122,46 @@ impl<const N: usize> WithSimd for Congruence<'_, N> {
         }
         Some(true)
     }
+}
+
+/// The leading principal minors of the lower triangle of `P` (`N x N`, column-major) all
+/// within `[1 / f64::MAX, f64::MAX]`, by fraction-free elimination on whole columns: the
+/// operations of `positive_definite_minors` in the same order (no fused multiply-adds), so
+/// the same verdict; the lanes above the diagonal and past a column's end are never read by
+/// the lanes below it.
+#[inline(always)]
+fn leading_minors_positive<S: Simd, const N: usize>(simd: S, p: &[f64]) -> bool {
+    let lanes = S::F64_LANES;
+    let nv = N.div_ceil(lanes);
+    let zero = simd.splat_f64s(0.0);
+    let mut a = [[zero; MAX_VECTORS]; N];
+    for j in 0..N {
+        for v in 0..nv {
+            a[j][v] = load(simd, p, j * N + v * lanes);
+        }
+    }
+    let big = f64::MAX;
+    let tiny = 1.0 / big;
+    let mut ok = true;
+    let mut inv_prev = 1.0;
+    let mut col = [0.0; 2 * 8];
+    for k in 0..N {
+        for v in 0..nv {
+            S::as_mut_simd_f64s(&mut col[v * lanes..(v + 1) * lanes]).0[0] = a[k][v];
+        }
+        let pk = col[k];
+        ok &= (pk >= tiny) & (pk <= big);
+        let (pv, iv) = (simd.splat_f64s(pk), simd.splat_f64s(inv_prev));
+        for j in (k + 1)..N {
+            let ajk = simd.splat_f64s(col[j]);
+            for v in 0..nv {
+                let t = simd.sub_f64s(simd.mul_f64s(pv, a[j][v]), simd.mul_f64s(a[k][v], ajk));
+                a[j][v] = simd.mul_f64s(t, iv);
+            }
+        }
+        inv_prev = 1.0 / pk;
+    }
+    ok
 }
 
 /// `S::F64_LANES` (at most 8) elements of `m` from `from`, as a vector: the kernels read
@@ -222,6 +239,39 @@ where
     D: Dim,
     DefaultAllocator: Allocator<D, D>,
 {
+    congruence_simd_with(f, p, q, true)
+}
+
+/// [`congruence_simd`] without the leading-minors check (`P` taken as it is, its lower
+/// triangle read): for a `P` the caller verified by other means, or chose not to verify
+/// ([`InputChecks::Cheap`](crate::InputChecks::Cheap)). `Some` wherever
+/// [`congruence_simd_applies`].
+#[inline(always)]
+pub(crate) fn congruence_simd_unchecked<T, D>(
+    f: &OMatrix<T, D, D>,
+    p: &OMatrix<T, D, D>,
+    q: &OMatrix<T, D, D>,
+) -> Option<OMatrix<T, D, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D>,
+{
+    congruence_simd_with(f, p, q, false)
+}
+
+#[inline(always)]
+fn congruence_simd_with<T, D>(
+    f: &OMatrix<T, D, D>,
+    p: &OMatrix<T, D, D>,
+    q: &OMatrix<T, D, D>,
+    check: bool,
+) -> Option<OMatrix<T, D, D>>
+where
+    T: RealField + Copy,
+    D: Dim,
+    DefaultAllocator: Allocator<D, D>,
+{
     if !congruence_simd_applies::<T, D>() {
         return None;
     }
@@ -238,24 +288,28 @@ where
             p,
             q,
             out: out_slice,
+            check,
         }),
         6 => arch.dispatch(Congruence::<6> {
             f,
             p,
             q,
             out: out_slice,
+            check,
         }),
         7 => arch.dispatch(Congruence::<7> {
             f,
             p,
             q,
             out: out_slice,
+            check,
         }),
         _ => arch.dispatch(Congruence::<8> {
             f,
             p,
             q,
             out: out_slice,
+            check,
         }),
     };
     (done == Some(true)).then_some(out)
@@ -325,6 +379,22 @@ mod tests {
         for bad in [indefinite, semidefinite, p * 1e300] {
             assert!(!positive_definite_minors(bad));
             assert!(congruence_simd(&f, &bad, &q).is_none());
+            // without the check, the product of whatever P is given
+            let Some(fast) = congruence_simd_unchecked(&f, &bad, &q) else {
+                assert!(
+                    matches!(Arch::new(), Arch::Scalar),
+                    "N = {N}: no unchecked result"
+                );
+                continue;
+            };
+            let plain = mul_tr_sym_plus(&mul(&f, &bad), &f, &q);
+            let top = plain.amax();
+            for (x, y) in fast.iter().zip(plain.iter()) {
+                assert!(
+                    (x - y).abs() <= 1e-13 * top,
+                    "N = {N}: unchecked {x} against {y}"
+                );
+            }
         }
     }
 
