@@ -7,8 +7,8 @@ use crate::driver::scan;
 use crate::error::Result;
 use crate::linalg::{
     Ldl, all_finite, check_dim, check_finite, check_square, check_state, congruence_ldl,
-    congruence_simd, congruence_simd_applies, congruence_simd_unchecked, is_static, joseph, ldl,
-    mean_finite_and_symmetric, mul, mul_tr_sym_plus, mul_vec, positive_definite_minors, symmetrise,
+    congruence_simd, congruence_simd_applies, is_static, joseph, ldl, mean_finite_and_symmetric,
+    mul, mul_tr_sym_plus, mul_vec, positive_definite_minors, symmetrise,
 };
 use crate::model::{LinearTransitionModel, Observation};
 use nalgebra::allocator::Allocator;
@@ -543,7 +543,7 @@ where
             (fast_ok && positive_definite_minors(state.covariance.clone()))
                 .then(|| tr.propagate_covariance(&state.covariance))
         } else if congruence_simd_applies::<T, D>() {
-            congruence_simd(f, &state.covariance, tr.process_noise()).filter(|_| fast_ok)
+            congruence_simd(f, &state.covariance, tr.process_noise(), true).filter(|_| fast_ok)
         } else {
             congruence_ldl(f, &state.covariance, tr.process_noise()).filter(|_| fast_ok)
         };
@@ -560,7 +560,7 @@ where
     // without the factorisation (`InputChecks::Cheap`), the SIMD product still applies where
     // the factorising path would have used it: the same covariance for a `P` that passes
     let simd = (!factorise && is_static::<D, D>() && !tr.has_structured_propagation())
-        .then(|| congruence_simd_unchecked(f, &state.covariance, tr.process_noise()))
+        .then(|| congruence_simd(f, &state.covariance, tr.process_noise(), false))
         .flatten();
     Ok(Gaussian {
         mean: tr.propagate_mean(&state.mean),

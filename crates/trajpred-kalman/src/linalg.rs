@@ -10,7 +10,7 @@ use trajpred_core::Gaussian;
 
 mod congruence;
 mod factor;
-pub(crate) use congruence::{congruence_simd, congruence_simd_applies, congruence_simd_unchecked};
+pub(crate) use congruence::{congruence_simd, congruence_simd_applies};
 pub(crate) use factor::{Chol, Ldl, cholesky, ldl};
 
 /// Errors with [`trajpred_core::Error::NonFinite`] if any element of `m` is NaN or infinite.

@@ -224,44 +224,15 @@ pub(crate) fn congruence_simd_applies<T: RealField + Copy, D: Dim>() -> bool {
 }
 
 /// `F P F^T + (Q + Q^T) / 2`, exactly symmetric, from the lower triangle of `P`, through the
-/// SIMD kernel, when `P` passes the leading-minors check (the verdict of
+/// SIMD kernel, in `f64` matrices of 5 to 8 states on a machine with AVX2 or AVX-512
+/// ([`congruence_simd_applies`]; `None` otherwise). With `check`, only when `P` passes the
+/// leading-minors check (the verdict of
 /// [`positive_definite_minors`](super::positive_definite_minors), which it reproduces
-/// operation for operation): `Some` for such a `P` in `f64` matrices of 5 to 8 states on a
-/// machine with AVX2 or AVX-512 ([`congruence_simd_applies`]), `None` otherwise.
+/// operation for operation; `None` when it fails); without it, `P` is taken as it is (for a
+/// `P` verified by other means, or not to be verified:
+/// [`InputChecks::Cheap`](crate::InputChecks::Cheap)).
 #[inline(always)]
 pub(crate) fn congruence_simd<T, D>(
-    f: &OMatrix<T, D, D>,
-    p: &OMatrix<T, D, D>,
-    q: &OMatrix<T, D, D>,
-) -> Option<OMatrix<T, D, D>>
-where
-    T: RealField + Copy,
-    D: Dim,
-    DefaultAllocator: Allocator<D, D>,
-{
-    congruence_simd_with(f, p, q, true)
-}
-
-/// [`congruence_simd`] without the leading-minors check (`P` taken as it is, its lower
-/// triangle read): for a `P` the caller verified by other means, or chose not to verify
-/// ([`InputChecks::Cheap`](crate::InputChecks::Cheap)). `Some` wherever
-/// [`congruence_simd_applies`].
-#[inline(always)]
-pub(crate) fn congruence_simd_unchecked<T, D>(
-    f: &OMatrix<T, D, D>,
-    p: &OMatrix<T, D, D>,
-    q: &OMatrix<T, D, D>,
-) -> Option<OMatrix<T, D, D>>
-where
-    T: RealField + Copy,
-    D: Dim,
-    DefaultAllocator: Allocator<D, D>,
-{
-    congruence_simd_with(f, p, q, false)
-}
-
-#[inline(always)]
-fn congruence_simd_with<T, D>(
     f: &OMatrix<T, D, D>,
     p: &OMatrix<T, D, D>,
     q: &OMatrix<T, D, D>,
@@ -341,7 +312,7 @@ mod tests {
         for q in [q, (q + q.transpose()) * 0.5] {
             let plain = mul_tr_sym_plus(&mul(&f, &p), &f, &q);
             let arch_has_vectors = !matches!(Arch::new(), Arch::Scalar);
-            match congruence_simd(&f, &p, &q) {
+            match congruence_simd(&f, &p, &q, true) {
                 Some(fast) => {
                     for j in 0..N {
                         for i in 0..N {
@@ -369,7 +340,7 @@ mod tests {
                 p_upper_nan[(i, j)] = f64::NAN;
             }
         }
-        if let Some(fast) = congruence_simd(&f, &p_upper_nan, &q) {
+        if let Some(fast) = congruence_simd(&f, &p_upper_nan, &q, true) {
             assert!(fast.iter().all(|v| v.is_finite()));
         }
         // the verdict of the scalar minors check: indefinite, semi-definite, huge
@@ -378,9 +349,9 @@ mod tests {
         let semidefinite = a.columns(0, 1) * a.columns(0, 1).transpose();
         for bad in [indefinite, semidefinite, p * 1e300] {
             assert!(!positive_definite_minors(bad));
-            assert!(congruence_simd(&f, &bad, &q).is_none());
+            assert!(congruence_simd(&f, &bad, &q, true).is_none());
             // without the check, the product of whatever P is given
-            let Some(fast) = congruence_simd_unchecked(&f, &bad, &q) else {
+            let Some(fast) = congruence_simd(&f, &bad, &q, false) else {
                 assert!(
                     matches!(Arch::new(), Arch::Scalar),
                     "N = {N}: no unchecked result"
@@ -406,8 +377,8 @@ mod tests {
         check::<8>();
         // other sizes and types are left to the caller
         let f4 = SMatrix::<f64, 4, 4>::identity();
-        assert!(congruence_simd(&f4, &f4, &f4).is_none());
+        assert!(congruence_simd(&f4, &f4, &f4, true).is_none());
         let f6 = SMatrix::<f32, 6, 6>::identity();
-        assert!(congruence_simd(&f6, &f6, &f6).is_none());
+        assert!(congruence_simd(&f6, &f6, &f6, true).is_none());
     }
 }
