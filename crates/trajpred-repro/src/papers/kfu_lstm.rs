@@ -28,8 +28,9 @@
 //! The table's layout and the claims are in `papers/kfu-lstm.toml`; this module computes the
 //! numbers ([`train`]: training and scoring; `flight`: the real flight and the figures).
 
+use crate::pool::map_in_parallel;
 use crate::runner::{Computed, Row, assemble};
-use crate::{Context, Paper, PaperResult, Result, Value};
+use crate::{Context, Paper, PaperResult, ReproError, Result, Value};
 use flight::{figures, load_flight};
 use serde::Deserialize;
 use train::{Case, MethodRun, run_once};
@@ -190,17 +191,32 @@ pub fn run(ctx: &Context) -> Result<PaperResult> {
     let bar = ctx.bar((cases.len() * s.reps) as u64, "kfu-lstm: series x seeds");
     let mut beats = Vec::new();
     let mut persistence = Vec::new();
-    for (si, case) in cases.iter().enumerate() {
+    // every (series, seed) run is seeded on its own: two workers pull them in order, as the
+    // fair comparison's jobs, and the results do not depend on which worker ran which
+    let jobs: Vec<(usize, usize)> = (0..cases.len())
+        .flat_map(|si| (0..s.reps).map(move |rep| (si, rep)))
+        .collect();
+    let mut done = map_in_parallel(&jobs, 2, |&(si, rep)| -> Result<(_, Vec<MethodRun>)> {
+        let case = &cases[si];
+        let seed = seed_of(ctx.seed, si, rep);
+        let noisy = observe(&case.truth, &case.sigma, seed)?;
+        let runs = run_once(case, &noisy, seed, &p, &s)?;
+        bar.inc(1);
+        Ok((noisy, runs))
+    })
+    .into_iter();
+    for case in &cases {
         // runs[rep][method]
         let mut runs: Vec<Vec<MethodRun>> = Vec::new();
         for rep in 0..s.reps {
-            let seed = seed_of(ctx.seed, si, rep);
-            let noisy = observe(&case.truth, &case.sigma, seed)?;
-            runs.push(run_once(case, &noisy, seed, &p, &s)?);
-            bar.inc(1);
+            let (noisy, run) = done.next().ok_or_else(|| ReproError::Experiment {
+                experiment: format!("kfu-lstm/{}", case.name),
+                reason: "a seed's run is missing".into(),
+            })??;
             if rep == 0 {
-                figures(&labels, &mut out.figures, case, &noisy, &runs[0])?;
+                figures(&labels, &mut out.figures, case, &noisy, &run)?;
             }
+            runs.push(run);
         }
         let m = series_rows(&keys, case, &runs, &mut out);
         beats.push(format!(
