@@ -1,4 +1,4 @@
-//! `F P F^T + (Q + Q^T) / 2` for `f64` matrices of 5 to 8 states, written once against
+//! `F P F^T + (Q + Q^T) / 2` for `f64` matrices of 5 to 8 states (4 with AVX2), written once against
 //! `pulp`'s safe SIMD types and dispatched at run time (AVX-512 or AVX2 with fused
 //! multiply-adds; without either, `None` and the caller keeps its scalar loops), as the
 //! kernels of trajpred-sparse and trajpred-neural are.
@@ -89,15 +89,19 @@ impl<const N: usize> WithSimd for Congruence<'_, N> {
                 q_exact &= q[i + j * N] == q[j + i * N];
             }
         }
-        let mut qs = [0.0; 64];
-        if !q_exact {
+        let qs: [f64; 64];
+        let q_used = if q_exact {
+            q
+        } else {
+            let mut c = [0.0; 64];
             for j in 0..N {
                 for i in j..N {
-                    qs[i + j * N] = (q[i + j * N] + q[j + i * N]) * 0.5;
+                    c[i + j * N] = (q[i + j * N] + q[j + i * N]) * 0.5;
                 }
             }
-        }
-        let q_used = if q_exact { q } else { &qs[..len] };
+            qs = c;
+            &qs[..len]
+        };
         // out[:, j] = qs[:, j] + sum_k G[:, k] F[j, k], stored in increasing `j` (a store's
         // lanes past the column's end are overwritten by the next column's)
         for j in 0..N {
@@ -194,13 +198,29 @@ pub(super) fn store<S: Simd>(_simd: S, m: &mut [f64], from: usize, x: S::f64s) {
     }
 }
 
-/// `f64` elements, a static size of 5 to 8, vectors of at least 4 lanes (AVX2 or AVX-512):
+/// `f64` elements, a static size of 5 to 8 with vectors of at least 4 lanes (AVX2 or
+/// AVX-512), or of 4 with vectors of exactly 4 (AVX2):
 /// where the kernels apply.
 #[inline(always)]
 pub(super) fn is_f64_of_size<T: RealField + Copy, D: Dim>() -> bool {
     TypeId::of::<T>() == TypeId::of::<f64>()
-        && D::try_to_usize().is_some_and(|n| (5..=8).contains(&n))
-        && !matches!(Arch::new(), Arch::Scalar)
+        && D::try_to_usize().is_some_and(|n| match n {
+            // 4 states are one vector of AVX2; in AVX-512's 8 lanes, half of each would be
+            // wasted and the scalar factorisation is as fast
+            4 => Arch::new().dispatch(Lanes) == 4,
+            _ => (5..=8).contains(&n) && !matches!(Arch::new(), Arch::Scalar),
+        })
+}
+
+/// The `f64` lanes of the dispatched vectors.
+struct Lanes;
+
+impl WithSimd for Lanes {
+    type Output = usize;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _simd: S) -> usize {
+        S::F64_LANES
+    }
 }
 
 /// The column-major elements of `m` when `T` is `f64`.
@@ -217,14 +237,16 @@ where
 }
 
 /// Whether [`congruence_simd`] gives a result for these types on this machine: `f64`, a
-/// static size of 5 to 8, vectors of at least 4 lanes (AVX2 or AVX-512).
+/// static size of 5 to 8, vectors of at least 4 lanes (AVX2 or AVX-512), or 4 states with
+/// AVX2.
 #[inline(always)]
 pub(crate) fn congruence_simd_applies<T: RealField + Copy, D: Dim>() -> bool {
     is_f64_of_size::<T, D>()
 }
 
 /// `F P F^T + (Q + Q^T) / 2`, exactly symmetric, from the lower triangle of `P`, through the
-/// SIMD kernel, in `f64` matrices of 5 to 8 states on a machine with AVX2 or AVX-512
+/// SIMD kernel, in `f64` matrices of 5 to 8 states on a machine with AVX2 or AVX-512 (and of
+/// 4 with AVX2)
 /// ([`congruence_simd_applies`]; `None` otherwise). With `check`, only when `P` passes the
 /// leading-minors check (the verdict of
 /// [`positive_definite_minors`](super::positive_definite_minors), which it reproduces
@@ -254,6 +276,13 @@ where
     let out_slice = o.as_mut_slice();
     let arch = Arch::new();
     let done = match n {
+        4 => arch.dispatch(Congruence::<4> {
+            f,
+            p,
+            q,
+            out: out_slice,
+            check,
+        }),
         5 => arch.dispatch(Congruence::<5> {
             f,
             p,
@@ -311,7 +340,7 @@ mod tests {
         // a Q that is not exactly symmetric, and one that is
         for q in [q, (q + q.transpose()) * 0.5] {
             let plain = mul_tr_sym_plus(&mul(&f, &p), &f, &q);
-            let arch_has_vectors = !matches!(Arch::new(), Arch::Scalar);
+            let applies = congruence_simd_applies::<f64, nalgebra::Const<N>>();
             match congruence_simd(&f, &p, &q, true) {
                 Some(fast) => {
                     for j in 0..N {
@@ -327,10 +356,7 @@ mod tests {
                         }
                     }
                 }
-                None => assert!(
-                    !arch_has_vectors,
-                    "N = {N}: no kernel result on a SIMD machine"
-                ),
+                None => assert!(!applies, "N = {N}: no kernel result where it applies"),
             }
         }
         // the upper triangle of P is not read
@@ -371,13 +397,14 @@ mod tests {
 
     #[test]
     fn kernel_matches_the_plain_loops() {
+        check::<4>();
         check::<5>();
         check::<6>();
         check::<7>();
         check::<8>();
         // other sizes and types are left to the caller
-        let f4 = SMatrix::<f64, 4, 4>::identity();
-        assert!(congruence_simd(&f4, &f4, &f4, true).is_none());
+        let f3 = SMatrix::<f64, 3, 3>::identity();
+        assert!(congruence_simd(&f3, &f3, &f3, true).is_none());
         let f6 = SMatrix::<f32, 6, 6>::identity();
         assert!(congruence_simd(&f6, &f6, &f6, true).is_none());
     }
