@@ -509,9 +509,10 @@ where
 /// definiteness check of `P` is an `L D L^T` factorisation: for a dense `F` the one from
 /// which `F P F^T` is then formed ([`congruence_ldl`]), for a structured `F` a factorisation
 /// of its own before the cheap structured product; for a dense `F` of 5 to 8 states in
-/// `f64` on a machine with AVX2 or AVX-512, the leading-minors check and then the SIMD
-/// products ([`congruence_simd`]); either way a `P` that is only
-/// semi-definite (or fails any check) takes the check `checks` of [`validate_state`]. The
+/// `f64` on a machine with AVX2 or AVX-512 (or 4 states with AVX2), the leading-minors check
+/// and then the SIMD products ([`congruence_simd`]); either way a `P` that is only
+/// semi-definite (or fails any check) takes the check `checks` of [`validate_state`]. Without
+/// `factorise`, that check, then the SIMD products without the minors where they apply. The
 /// caller passes the same `factorise` for `predict` and `predict_own_output`, so a batch
 /// and the same steps one by one give identical results.
 ///
