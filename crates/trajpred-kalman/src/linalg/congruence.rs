@@ -204,11 +204,16 @@ pub(super) fn store<S: Simd>(_simd: S, m: &mut [f64], from: usize, x: S::f64s) {
 #[inline(always)]
 pub(super) fn is_f64_of_size<T: RealField + Copy, D: Dim>() -> bool {
     TypeId::of::<T>() == TypeId::of::<f64>()
-        && D::try_to_usize().is_some_and(|n| match n {
-            // 4 states are one vector of AVX2; in AVX-512's 8 lanes, half of each would be
-            // wasted and the scalar factorisation is as fast
-            4 => Arch::new().dispatch(Lanes) == 4,
-            _ => (5..=8).contains(&n) && !matches!(Arch::new(), Arch::Scalar),
+        && D::try_to_usize().is_some_and(|n| {
+            // exactly where the kernel answers (it declines vectors of fewer than 4 lanes,
+            // such as NEON's 2): 4 states are one vector of AVX2, while in AVX-512's 8 lanes
+            // half of each would be wasted and the scalar factorisation is as fast
+            let lanes = Arch::new().dispatch(Lanes);
+            match n {
+                4 => lanes == 4,
+                5..=8 => (4..=8).contains(&lanes),
+                _ => false,
+            }
         })
 }
 
