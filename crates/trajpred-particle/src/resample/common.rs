@@ -140,6 +140,22 @@ pub(super) fn ceil_near(h: f64, margin: f64) -> (usize, bool) {
 /// halves run by `rayon::join`.
 pub(super) const PARALLEL_MIN: usize = 1 << 17;
 
+/// Runs `a` on the calling thread and `b` on rayon's pool at the same time, returning when
+/// both are done.
+///
+/// Not `rayon::join`: called from outside the pool (a user's thread, as resampling usually
+/// is), `join` hands both halves to one worker, and the second half runs in parallel only
+/// once a second worker has woken and stolen it. On the 2-core machine of docs/particle.md
+/// that failed in most calls after a millisecond of single-threaded work (two 1 ms halves
+/// took 2.1 ms, in sequence), while a job queued from the calling thread, which then works
+/// on its own half, was picked up in time (1.1 ms). Inside the pool both behave alike.
+pub(super) fn join_here(a: impl FnOnce(), b: impl FnOnce() + Send) {
+    rayon::in_place_scope(|s| {
+        s.spawn(|_| b());
+        a();
+    });
+}
+
 /// Index `i` with `C_(i-1) <= p < C_i` in a cumulative-sum array, by binary search,
 /// clamped to `last`.
 pub(super) fn search(cumsum: &[f64], p: f64, last: usize) -> usize {

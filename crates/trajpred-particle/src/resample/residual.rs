@@ -450,7 +450,7 @@ pub(super) fn run_parts(weights: &[f64], scale: f64, parts: &[Part], out: &mut [
         _ => {
             let (left, right) = parts.split_at(parts.len() / 2);
             let (a, b) = out.split_at_mut(left.iter().map(Part::slots).sum());
-            rayon::join(
+            join_here(
                 || run_parts(weights, scale, left, a),
                 || run_parts(weights, scale, right, b),
             );

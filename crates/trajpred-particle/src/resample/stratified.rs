@@ -3,6 +3,7 @@
 use super::Resampler;
 use super::common::*;
 use crate::error::Result;
+use pulp::{Arch, Simd, WithSimd};
 use rand::Rng;
 use trajpred_core::Error as CoreError;
 
@@ -131,16 +132,36 @@ pub(super) fn stratified_counts(weights: &[f64], c: Checked, key: u64, out: &mut
     {
         let k_mid = k.count(c.mid_sum);
         let (first, second) = out.split_at_mut(k_mid);
-        rayon::join(
-            || k.run(&weights[..h], 0, 0.0, first),
+        join_here(
             || {
-                let end = k.run(&weights[h..=c.last], h, c.mid_sum, second);
+                k.dispatch(&weights[..h], 0, 0.0, first);
+            },
+            || {
+                let end = k.dispatch(&weights[h..=c.last], h, c.mid_sum, second);
                 second[end..].fill(c.last);
             },
         );
     } else {
-        let end = k.run(&weights[..=c.last], 0, 0.0, out);
+        let end = k.dispatch(&weights[..=c.last], 0, 0.0, out);
         out[end..].fill(c.last);
+    }
+}
+
+/// [`StratifiedCount::run`] compiled for the widest instruction set the processor offers
+/// (`pulp`'s run-time dispatch), where a run of [`RUN`] slots is one vector store.
+struct Run<'a> {
+    k: StratifiedCount,
+    weights: &'a [f64],
+    first: usize,
+    cum: f64,
+    out: &'a mut [usize],
+}
+
+impl WithSimd for Run<'_> {
+    type Output = usize;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _simd: S) -> usize {
+        self.k.run(self.weights, self.first, self.cum, self.out)
     }
 }
 
@@ -153,6 +174,17 @@ pub(super) struct StratifiedCount {
 }
 
 impl StratifiedCount {
+    /// [`run`](Self::run), dispatched.
+    fn dispatch(&self, weights: &[f64], first: usize, cum: f64, out: &mut [usize]) -> usize {
+        Arch::new().dispatch(Run {
+            k: *self,
+            weights,
+            first,
+            cum,
+            out,
+        })
+    }
+
     /// `#{j < n : j + u_j < cum n / W}`.
     #[inline(always)]
     fn count(&self, cum: f64) -> usize {
@@ -183,11 +215,26 @@ impl StratifiedCount {
                 *k = self.count(cum);
             }
             let first = first + b * BATCH;
-            for (s, &k) in ks[..batch.len()].iter().enumerate() {
-                // non-decreasing, so at least `start`
-                let k = k.saturating_sub(base).min(len);
-                fill_run(out, start, k, first + s);
-                start = k;
+            let ks = &ks[..batch.len()];
+            // the counts are non-decreasing: where the batch's last one leaves room for a
+            // run's fixed-width store, no count needs the clamps
+            if ks[0] >= base && ks[ks.len() - 1] - base + RUN <= len {
+                for (s, &k) in ks.iter().enumerate() {
+                    let k = k - base;
+                    if k - start <= RUN {
+                        out[start..start + RUN].copy_from_slice(&[first + s; RUN]);
+                    } else {
+                        out[start..k].fill(first + s);
+                    }
+                    start = k;
+                }
+            } else {
+                for (s, &k) in ks.iter().enumerate() {
+                    // non-decreasing, so at least `start`
+                    let k = k.saturating_sub(base).min(len);
+                    fill_run(out, start, k, first + s);
+                    start = k;
+                }
             }
         }
         start

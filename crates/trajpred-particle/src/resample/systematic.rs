@@ -3,6 +3,7 @@
 use super::Resampler;
 use super::common::*;
 use crate::error::Result;
+use pulp::{Arch, Simd, WithSimd};
 use rand::{Rng, RngExt};
 
 /// Systematic resampling for a given offset `u in [0, 1]`: positions `(j + u) / n`
@@ -56,15 +57,17 @@ pub(super) fn systematic_counts(weights: &[f64], c: Checked, offset: f64, out: &
     {
         let k_mid = k.count(c.mid_sum, 0);
         let (first, second) = out.split_at_mut(k_mid);
-        rayon::join(
-            || k.run(&weights[..h], 0, 0.0, first),
+        join_here(
             || {
-                let end = k.run(&weights[h..=c.last], h, c.mid_sum, second);
+                k.dispatch(&weights[..h], 0, 0.0, first);
+            },
+            || {
+                let end = k.dispatch(&weights[h..=c.last], h, c.mid_sum, second);
                 second[end - k_mid..].fill(c.last);
             },
         );
     } else {
-        let end = k.run(&weights[..=c.last], 0, 0.0, out);
+        let end = k.dispatch(&weights[..=c.last], 0, 0.0, out);
         out[end..].fill(c.last);
     }
 }
@@ -137,6 +140,37 @@ impl SystematicCount {
             start = k;
         }
         start + base
+    }
+}
+
+/// [`SystematicCount::run`] compiled for the widest instruction set the processor offers
+/// (`pulp`'s run-time dispatch), where a run of [`RUN`] slots is one vector store.
+struct Run<'a> {
+    k: SystematicCount,
+    weights: &'a [f64],
+    first: usize,
+    cum: f64,
+    out: &'a mut [usize],
+}
+
+impl WithSimd for Run<'_> {
+    type Output = usize;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _simd: S) -> usize {
+        self.k.run(self.weights, self.first, self.cum, self.out)
+    }
+}
+
+impl SystematicCount {
+    /// [`run`](Self::run), dispatched.
+    fn dispatch(&self, weights: &[f64], first: usize, cum: f64, out: &mut [usize]) -> usize {
+        Arch::new().dispatch(Run {
+            k: *self,
+            weights,
+            first,
+            cum,
+            out,
+        })
     }
 }
 
