@@ -98,8 +98,18 @@ pub(super) fn stratum_uniform(key: u64, j: usize) -> f64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^= z >> 31;
-    // below 2^53: the signed conversion, one instruction
-    (z >> 11) as i64 as f64 * (1.0 / (1u64 << 53) as f64)
+    exact_f64(z >> 11) * (1.0 / (1u64 << 53) as f64)
+}
+
+/// `m` as `f64`, exactly for `m < 2^53`, from the bits of its two 32-bit halves placed in the
+/// significands of `2^84` and `2^52` (the conversion instruction for 64-bit integers exists
+/// only in AVX-512, and a vectorised batch of counts would leave the vectors for it).
+#[inline(always)]
+fn exact_f64(m: u64) -> f64 {
+    let hi =
+        f64::from_bits(0x4530_0000_0000_0000 | (m >> 32)) - 19_342_813_118_337_666_422_669_312.0;
+    let lo = f64::from_bits(0x4330_0000_0000_0000 | (m & 0xFFFF_FFFF));
+    hi + lo
 }
 
 /// Stratified resampling as counts per input particle, in one pass over the weights.
@@ -189,12 +199,16 @@ impl StratifiedCount {
     #[inline(always)]
     fn count(&self, cum: f64) -> usize {
         // `j0 = floor(x)` and `x - j0`, exact for `0 <= x < 2^51` (as in [`split`]), without
-        // a data-dependent branch: `f` is `x` rounded to the nearest integer, one too many
-        // where it rounded up
+        // a data-dependent branch or a conversion instruction (so that a batch of counts
+        // vectorises): `y - ROUND` is `x` rounded to the nearest integer, one too many where
+        // it rounded up
         let x = cum * self.scale;
         let y = x + ROUND;
-        let j0 = rounded(y).wrapping_sub(usize::from(y - ROUND > x));
-        let frac = x - j0 as i64 as f64;
+        let r = y - ROUND;
+        let up = r > x;
+        let floor = if up { r - 1.0 } else { r };
+        let j0 = rounded(y).wrapping_sub(usize::from(up));
+        let frac = x - floor;
         (j0 + usize::from(stratum_uniform(self.key, j0) < frac)).min(self.n)
     }
 
@@ -209,10 +223,15 @@ impl StratifiedCount {
         // the counts of a batch first (independent of each other but for the running sum,
         // so the hash of one overlaps the next), then its runs
         let mut ks = [0usize; BATCH];
+        let mut cums = [0.0f64; BATCH];
         for (b, batch) in weights.chunks(BATCH).enumerate() {
-            for (k, &w) in ks.iter_mut().zip(batch) {
+            // the running sums (one chain), then the counts, independent of each other
+            for (c, &w) in cums.iter_mut().zip(batch) {
                 cum += w;
-                *k = self.count(cum);
+                *c = cum;
+            }
+            for (k, &c) in ks.iter_mut().zip(&cums) {
+                *k = self.count(c);
             }
             let first = first + b * BATCH;
             let ks = &ks[..batch.len()];
@@ -238,5 +257,26 @@ impl StratifiedCount {
             }
         }
         start
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exact_f64_is_the_conversion_below_2_pow_53() {
+        let mut m = 0x2545_F491_4F6C_DD1Du64;
+        let mut cases = vec![0, 1, (1 << 32) - 1, 1 << 32, (1 << 32) + 1, (1 << 52) + 1];
+        cases.push((1 << 53) - 1);
+        for _ in 0..10_000 {
+            m ^= m << 13;
+            m ^= m >> 7;
+            m ^= m << 17;
+            cases.push(m >> 11);
+        }
+        for m in cases {
+            assert_eq!(exact_f64(m).to_bits(), (m as f64).to_bits(), "m = {m}");
+        }
     }
 }
