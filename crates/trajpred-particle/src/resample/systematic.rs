@@ -122,26 +122,64 @@ impl SystematicCount {
     /// Writes the slots of the particles `first..first + weights.len()` (whose running sum
     /// starts at `cum`) into `out`, which holds the slots from `k` of particle `first - 1`
     /// (0 for the first particle) on; returns `k` of the last particle, in absolute slots.
+    ///
+    /// By batches: the running sums (one chain), then the estimates of the counts with their
+    /// near-tie flags (independent of each other: they vectorise), corrected one by one in
+    /// the rare batch that has a near tie, then the runs, without clamps where the batch's
+    /// last count leaves room for a run's fixed-width store.
     #[inline(always)]
     fn run(&self, weights: &[f64], first: usize, mut cum: f64, out: &mut [usize]) -> usize {
         let base = if first == 0 { 0 } else { self.count(cum, 0) };
         let len = out.len();
-        // the fixed-width stores of the main loop need RUN slots from `start`
-        let lim = len.saturating_sub(RUN);
         let mut start = 0usize;
-        for (s, &w) in weights.iter().enumerate() {
-            cum += w;
-            let k = self.count(cum, start + base).saturating_sub(base).min(len);
-            if k.wrapping_sub(start) <= RUN && start <= lim && len >= RUN {
-                out[start..start + RUN].fill(first + s);
-            } else {
-                out[start..k].fill(first + s);
+        let mut prev = base;
+        let mut ks = [0usize; BATCH];
+        let mut cums = [0.0f64; BATCH];
+        for (b, batch) in weights.chunks(BATCH).enumerate() {
+            let m = batch.len();
+            for (c, &w) in cums.iter_mut().zip(batch) {
+                cum += w;
+                *c = cum;
             }
-            start = k;
+            let mut near = false;
+            for (k, &c) in ks.iter_mut().zip(&cums[..m]) {
+                let (estimate, close) = ceil_near(c * self.scale + self.half, self.margin);
+                *k = estimate;
+                near |= close;
+            }
+            if near {
+                for (k, &c) in ks.iter_mut().zip(&cums[..m]) {
+                    prev = self.count(c, prev);
+                    *k = prev;
+                }
+            }
+            let ks = &ks[..m];
+            prev = ks[m - 1];
+            let first = first + b * BATCH;
+            if ks[0] >= base && ks[m - 1] - base + RUN <= len {
+                for (s, &k) in ks.iter().enumerate() {
+                    let k = k - base;
+                    if k - start <= RUN {
+                        out[start..start + RUN].copy_from_slice(&[first + s; RUN]);
+                    } else {
+                        out[start..k].fill(first + s);
+                    }
+                    start = k;
+                }
+            } else {
+                for (s, &k) in ks.iter().enumerate() {
+                    let k = k.saturating_sub(base).min(len);
+                    fill_run(out, start, k, first + s);
+                    start = k;
+                }
+            }
         }
         start + base
     }
 }
+
+/// Particles per batch of [`SystematicCount::run`].
+const BATCH: usize = 64;
 
 /// [`SystematicCount::run`] compiled for the widest instruction set the processor offers
 /// (`pulp`'s run-time dispatch), where a run of [`RUN`] slots is one vector store.
