@@ -1,0 +1,168 @@
+//! The range-bearing sensor ([`RangeBearing`]) and the angle wrap its residuals use.
+
+use crate::error::{KalmanError, Result};
+use crate::linalg::{check_dim, check_pd};
+use crate::model::{Observation, ObservationJacobian, SigmaImages};
+use crate::motion::check_positive;
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim, Matrix2, OMatrix, OVector, RealField, U2, Vector2};
+use trajpred_core::Error as CoreError;
+
+/// Range and bearing of the target from a sensor at `(sx, sy)`:
+/// `h(x) = [sqrt(dx^2 + dy^2), atan2(dy, dx)]` with `dx = x[ix] - sx`, `dy = x[iy] - sy`.
+/// The bearing residual is wrapped into `[-pi, pi)`, and averaged bearings are wrapped back,
+/// so the filters handle targets crossing the `+-pi` line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RangeBearing<T: RealField> {
+    sensor: Vector2<T>,
+    x_index: usize,
+    y_index: usize,
+    r: Matrix2<T>,
+}
+
+impl<T: RealField + Copy> RangeBearing<T> {
+    /// A sensor at `sensor`, reading the target position from state components `x_index`
+    /// and `y_index`, with range variance `range_var` and bearing variance `bearing_var`
+    /// (rad^2).
+    pub fn new(
+        sensor: Vector2<T>,
+        x_index: usize,
+        y_index: usize,
+        range_var: f64,
+        bearing_var: f64,
+    ) -> Result<Self> {
+        check_positive("range_var", range_var, false)?;
+        check_positive("bearing_var", bearing_var, false)?;
+        let r = Matrix2::new(
+            nalgebra::convert(range_var),
+            T::zero(),
+            T::zero(),
+            nalgebra::convert(bearing_var),
+        );
+        check_pd(&r, "R")?;
+        if sensor.iter().any(|v| !v.is_finite()) {
+            return Err(CoreError::NonFinite {
+                what: "sensor position",
+                index: sensor.iter().position(|v| !v.is_finite()).unwrap_or(0),
+            }
+            .into());
+        }
+        Ok(RangeBearing {
+            sensor,
+            x_index,
+            y_index,
+            r,
+        })
+    }
+
+    fn offsets<D: Dim>(&self, x: &OVector<T, D>) -> Result<(T, T)>
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        let need = self.x_index.max(self.y_index) + 1;
+        if x.nrows() < need {
+            return Err(CoreError::DimensionMismatch {
+                what: "state too short for the position indices",
+                expected: need,
+                got: x.nrows(),
+            }
+            .into());
+        }
+        Ok((
+            x[self.x_index] - self.sensor.x,
+            x[self.y_index] - self.sensor.y,
+        ))
+    }
+}
+
+/// Wraps an angle into `[-pi, pi)`.
+pub fn wrap_angle<T: RealField + Copy>(a: T) -> T {
+    // the common case, an angle already in range, without the (slow) floating remainder
+    if a >= -T::pi() && a < T::pi() {
+        return a;
+    }
+    let two_pi = T::two_pi();
+    let r = (a + T::pi()) % two_pi;
+    let r = if r < T::zero() { r + two_pi } else { r };
+    r - T::pi()
+}
+
+impl<T: RealField + Copy, D: Dim> Observation<T, D, U2> for RangeBearing<T>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    fn observe(&self, x: &OVector<T, D>) -> Result<Vector2<T>> {
+        let (dx, dy) = self.offsets(x)?;
+        Ok(Vector2::new((dx * dx + dy * dy).sqrt(), dy.atan2(dx)))
+    }
+    fn observation_noise(&self) -> &Matrix2<T> {
+        &self.r
+    }
+    fn observation_residual(&self, a: &Vector2<T>, b: &Vector2<T>) -> Vector2<T> {
+        Vector2::new(a[0] - b[0], wrap_angle(a[1] - b[1]))
+    }
+    fn normalize_observation(&self, z: Vector2<T>) -> Vector2<T> {
+        Vector2::new(z[0], wrap_angle(z[1]))
+    }
+
+    /// `h` depends on the position only: a pair of sigma points whose offset `L_j` is zero
+    /// in both position components (every column after the position's, for a state
+    /// ordered with the positions first in their blocks, such as `[x, vx, y, vy, w]`: 2 of
+    /// the 5 pairs) has the centre's image exactly, without the `sqrt` and `atan2`.
+    fn observe_sigma_points(
+        &self,
+        x: &OVector<T, D>,
+        l: &OMatrix<T, D, D>,
+    ) -> Result<SigmaImages<T, D, U2>>
+    where
+        DefaultAllocator: Allocator<U2, D>,
+    {
+        let n = x.nrows();
+        check_dim("sigma-point spread", n, l.nrows())?;
+        check_dim("sigma-point spread", n, l.ncols())?;
+        let (dx, dy) = self.offsets(x)?;
+        let h = |dx: T, dy: T| Vector2::new((dx * dx + dy * dy).sqrt(), dy.atan2(dx));
+        let center = h(dx, dy);
+        let d = x.shape_generic().0;
+        let mut plus = OMatrix::<T, U2, D>::zeros_generic(nalgebra::Const::<2>, d);
+        let mut minus = OMatrix::<T, U2, D>::zeros_generic(nalgebra::Const::<2>, d);
+        for j in 0..n {
+            let (ex, ey) = (l[(self.x_index, j)], l[(self.y_index, j)]);
+            if ex == T::zero() && ey == T::zero() {
+                plus.set_column(j, &center);
+                minus.set_column(j, &center);
+            } else {
+                plus.set_column(j, &h(dx + ex, dy + ey));
+                minus.set_column(j, &h(dx - ex, dy - ey));
+            }
+        }
+        Ok(SigmaImages::<T, D, U2> {
+            center,
+            plus,
+            minus,
+        })
+    }
+}
+
+impl<T: RealField + Copy, D: Dim> ObservationJacobian<T, D, U2> for RangeBearing<T>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D> + Allocator<U2, D>,
+{
+    fn observation_jacobian(&self, x: &OVector<T, D>) -> Result<OMatrix<T, U2, D>> {
+        let (dx, dy) = self.offsets(x)?;
+        let r2 = dx * dx + dy * dy;
+        if r2 <= T::zero() || !r2.is_finite() {
+            return Err(KalmanError::Undefined {
+                what: "range-bearing Jacobian at the sensor position",
+            });
+        }
+        let r = r2.sqrt();
+        let d = x.shape_generic().0;
+        let mut h = OMatrix::<T, U2, D>::zeros_generic(nalgebra::Const::<2>, d);
+        h[(0, self.x_index)] = dx / r;
+        h[(0, self.y_index)] = dy / r;
+        h[(1, self.x_index)] = -dy / r2;
+        h[(1, self.y_index)] = dx / r2;
+        Ok(h)
+    }
+}
