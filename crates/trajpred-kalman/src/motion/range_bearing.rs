@@ -254,3 +254,72 @@ where
         self.len = 0;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Units in the last place between two finite `f64` of the same sign.
+    fn ulps(a: f64, b: f64) -> u64 {
+        if a == b {
+            0
+        } else {
+            (a.to_bits() as i64 - b.to_bits() as i64).unsigned_abs()
+        }
+    }
+
+    #[test]
+    fn bearings4_are_within_2_ulp_of_atan2() {
+        let mut s = 0x1234_5678_9ABC_DEF1u64;
+        let mut uniform = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        // every quadrant, both axes and the origin with both signs of zero, then random
+        // offsets over eight decades and ratios over two
+        let mut pairs = vec![
+            (0.0, 1.0),
+            (-0.0, 1.0),
+            (0.0, -1.0),
+            (-0.0, -1.0),
+            (1.0, 0.0),
+            (-1.0, 0.0),
+            (0.0, 0.0),
+            (3.0, 3.0),
+            (-3.0, 3.0),
+            (3.0, -3.0),
+            (-3.0, -3.0),
+            (1e-300, 1.0),
+            (1.0, 1e-300),
+        ];
+        for _ in 0..100_000 {
+            let scale = 10f64.powf(uniform() * 8.0 - 4.0);
+            let y = (2.0 * uniform() - 1.0) * scale;
+            let x = (2.0 * uniform() - 1.0) * scale * 10f64.powf(2.0 * uniform() - 1.0);
+            pairs.push((y, x));
+        }
+        for chunk in pairs.chunks(4) {
+            let mut y = [0.0; 4];
+            let mut x = [1.0; 4];
+            for (i, &(a, b)) in chunk.iter().enumerate() {
+                (y[i], x[i]) = (a, b);
+            }
+            let got = bearings4(y, x);
+            for i in 0..chunk.len() {
+                let want = y[i].atan2(x[i]);
+                assert!(
+                    ulps(got[i], want) <= 2,
+                    "atan2({}, {}) = {} against {want}",
+                    y[i],
+                    x[i],
+                    got[i]
+                );
+            }
+        }
+        // the generic path (f32) is the scalar function itself
+        let got = bearings4([1.0f32, -2.0, 0.5, 0.0], [2.0f32, 1.0, -3.0, -1.0]);
+        assert_eq!(got[1], (-2.0f32).atan2(1.0));
+    }
+}
