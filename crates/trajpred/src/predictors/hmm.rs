@@ -225,21 +225,37 @@ const ASSIGN_CHUNK: usize = 4096;
 /// Assigns each point of `flat` (`dim` values a point) to its nearest centroid of `cflat`
 /// (the first of equals, as [`nearest`]), in parallel over chunks of points; returns whether
 /// any assignment changed.
+///
+/// Per point, the squared distances to all centroids are formed first, coordinate by
+/// coordinate over a transposed copy of the centroids (each distance the same sum, in the
+/// same order, as [`sq_dist`]: they vectorise across centroids), then their minimum, then
+/// the first centroid at it: the answer of [`nearest`]'s running comparison, without its
+/// chain of dependent compares.
 fn assign_nearest(flat: &[f64], cflat: &[f64], dim: usize, assign: &mut [usize]) -> bool {
-    let near = |x: &[f64]| {
-        let mut best = (0, f64::INFINITY);
-        for (j, c) in cflat.chunks_exact(dim).enumerate() {
-            let d = sq_dist(c, x);
-            if d < best.1 {
-                best = (j, d);
+    let k = cflat.len() / dim.max(1);
+    // by coordinate: `by_axis[a * k + j]` is coordinate `a` of centroid `j`
+    let by_axis: Vec<f64> = (0..dim)
+        .flat_map(|a| cflat.chunks_exact(dim).map(move |c| c[a]))
+        .collect();
+    let near = |x: &[f64], ds: &mut [f64]| {
+        ds.fill(-0.0);
+        for (&xa, ca) in x.iter().zip(by_axis.chunks_exact(k)) {
+            for (d, &c) in ds.iter_mut().zip(ca) {
+                *d += (c - xa) * (c - xa);
             }
         }
-        best.0
+        let m = ds.iter().copied().fold(f64::INFINITY, f64::min);
+        if m < f64::INFINITY {
+            ds.iter().position(|&d| d == m).unwrap_or(0)
+        } else {
+            0
+        }
     };
     let pass = |(a, x): (&mut [usize], &[f64])| {
         let mut changed = false;
+        let mut ds = vec![0.0; k];
         for (a, x) in a.iter_mut().zip(x.chunks_exact(dim)) {
-            let j = near(x);
+            let j = near(x, &mut ds);
             changed |= *a != j;
             *a = j;
         }
@@ -366,49 +382,44 @@ fn train(seqs: &[Vec<Vec<f64>>], k: usize, params: &HmmParams) -> Result<HmmMode
     })
 }
 
-/// `dist` pushed through the transition matrix, `out[j] = sum_i dist[i] T[i][j]`, from the
-/// transposed matrix `tt` (row `j` holds column `j` of `T`, `k` values a row). Each `out[j]`
-/// is one sum over `i` in order, exactly as a plain `.sum()` would form it; four of them run
-/// side by side, so that the additions of one do not wait for those of the others.
-fn push_through(tt: &[f64], dist: &[f64]) -> Vec<f64> {
+/// `dist` pushed through the transition matrix `t` (row-major, `k x k`),
+/// `out[j] = sum_i dist[i] T[i][j]`. Each `out[j]` is one sum over `i` in order, exactly as a
+/// plain `.sum()` forms it (from `-0.0`, a product then an addition each); [`BLOCK`] of them
+/// are carried side by side, reading a contiguous piece of each row, so that the additions
+/// run in vectors and do not wait for each other. The last `k % BLOCK` are plain sums.
+fn push_through(t: &[Vec<f64>], dist: &[f64]) -> Vec<f64> {
     let k = dist.len();
     let mut out = vec![0.0; k];
-    let mut rows = tt.chunks_exact(k);
-    let mut outs = out.chunks_exact_mut(4);
-    for o in &mut outs {
-        let r: [&[f64]; 4] = std::array::from_fn(|_| rows.next().unwrap_or(&[]));
-        let mut acc = [-0.0f64; 4];
-        for (i, &p) in dist.iter().enumerate() {
-            for (a, r) in acc.iter_mut().zip(&r) {
-                *a += p * r[i];
+    let mut blocks = out.chunks_exact_mut(BLOCK);
+    for (b, o) in (&mut blocks).enumerate() {
+        let cols = b * BLOCK..(b + 1) * BLOCK;
+        let mut acc = [-0.0f64; BLOCK];
+        for (row, &p) in t.iter().zip(dist) {
+            for (a, &v) in acc.iter_mut().zip(&row[cols.clone()]) {
+                *a += p * v;
             }
         }
         o.copy_from_slice(&acc);
     }
-    for (o, r) in outs.into_remainder().iter_mut().zip(rows) {
-        *o = dist.iter().zip(r).map(|(p, t)| p * t).sum();
+    let done = k - blocks.into_remainder().len();
+    for (j, o) in out.iter_mut().enumerate().skip(done) {
+        *o = t.iter().zip(dist).map(|(row, &p)| p * row[j]).sum();
     }
     out
 }
 
-impl HmmModel {
-    /// The transition matrix transposed, flat: row `j` is column `j` of `transition`.
-    fn transposed(&self) -> Vec<f64> {
-        let k = self.transition.len();
-        (0..k)
-            .flat_map(|j| self.transition.iter().map(move |row| row[j]))
-            .collect()
-    }
+/// Outputs carried together by [`push_through`].
+const BLOCK: usize = 16;
 
+impl HmmModel {
     /// Forward-filtered distribution of the state of the last displacement.
     fn filter(&self, disp: &[Vec<f64>]) -> Vec<f64> {
-        let tt = self.transposed();
         let mut alpha = self.initial.clone();
         for (t, d) in disp.iter().enumerate() {
             let prior: Vec<f64> = if t == 0 {
                 self.initial.clone()
             } else {
-                push_through(&tt, &alpha)
+                push_through(&self.transition, &alpha)
             };
             let log_e: Vec<f64> = self
                 .centroids
@@ -435,10 +446,9 @@ impl HmmModel {
     /// Expected displacements of the next `horizon` steps, given the filtered distribution.
     fn expected_displacements(&self, mut dist: Vec<f64>, horizon: usize) -> Vec<Vec<f64>> {
         let k = self.centroids.len();
-        let tt = self.transposed();
         (0..horizon)
             .map(|_| {
-                dist = push_through(&tt, &dist);
+                dist = push_through(&self.transition, &dist);
                 (0..self.dim)
                     .map(|a| (0..k).map(|j| dist[j] * self.centroids[j][a]).sum())
                     .collect()
@@ -659,17 +669,17 @@ mod tests {
         }
     }
 
-    /// The transposed, four-chains product equals the plain column sums bit for bit (the
-    /// fit's choice of K and every forecast depend on it), at sizes around the chain count.
+    /// The blocked product equals the plain column sums bit for bit (the fit's choice of K
+    /// and every forecast depend on it), at sizes around the block.
     #[test]
     fn push_through_is_the_plain_sum_bit_for_bit() {
-        for k in [1, 2, 3, 4, 5, 7, 8, 9, 33, 128] {
+        for k in [1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 33, 128] {
             let m = model(k);
             let dist: Vec<f64> = (0..k).map(|i| m.transition[k / 2][i]).collect();
             let want: Vec<f64> = (0..k)
                 .map(|j| (0..k).map(|i| dist[i] * m.transition[i][j]).sum())
                 .collect();
-            let got = push_through(&m.transposed(), &dist);
+            let got = push_through(&m.transition, &dist);
             assert_eq!(
                 got.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
                 want.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
