@@ -2,6 +2,7 @@
 //! the binary search.
 
 use crate::error::{ParticleError, Result};
+use pulp::{Arch, Simd, WithSimd};
 use trajpred_core::Error as CoreError;
 
 /// Validated weights: their sum, the index of the last positive weight, and the running sum
@@ -160,4 +161,88 @@ pub(super) fn join_here(a: impl FnOnce(), b: impl FnOnce() + Send) {
 /// clamped to `last`.
 pub(super) fn search(cumsum: &[f64], p: f64, last: usize) -> usize {
     cumsum.partition_point(|&c| c <= p).min(last)
+}
+
+/// Particles per batch of the counting passes ([`CountPass`]): their counts are formed
+/// first (vectorised), then their runs written ([`write_runs`]).
+pub(super) const BATCH: usize = 64;
+
+/// Writes the runs of the particles `first..first + ks.len()` whose counts `ks` (absolute
+/// slots, non-decreasing, at least `base`) end their runs, into `out`, which holds the slots
+/// from `base` on and is written from `*start` (relative to `out`). Where the batch's last
+/// count leaves room for a run's fixed-width store, no count needs the clamps.
+#[inline(always)]
+pub(super) fn write_runs(
+    ks: &[usize],
+    base: usize,
+    first: usize,
+    start: &mut usize,
+    out: &mut [usize],
+) {
+    let len = out.len();
+    let (Some(&lo), Some(&hi)) = (ks.first(), ks.last()) else {
+        return;
+    };
+    if lo >= base && hi - base + RUN <= len {
+        for (s, &k) in ks.iter().enumerate() {
+            let k = k - base;
+            if k - *start <= RUN {
+                out[*start..*start + RUN].copy_from_slice(&[first + s; RUN]);
+            } else {
+                out[*start..k].fill(first + s);
+            }
+            *start = k;
+        }
+    } else {
+        for (s, &k) in ks.iter().enumerate() {
+            let k = k.saturating_sub(base).min(len);
+            fill_run(out, *start, k, first + s);
+            *start = k;
+        }
+    }
+}
+
+/// A counting pass of systematic or stratified resampling: writes the slots of the
+/// particles `first..first + weights.len()`, whose running sum starts at `cum`, into `out`;
+/// returns where the written slots end (each scheme documents in which units).
+pub(super) trait CountPass: Copy {
+    /// The pass itself; implementations are `#[inline(always)]`, so that
+    /// [`dispatch_pass`] compiles them for the processor's vectors.
+    fn run(&self, weights: &[f64], first: usize, cum: f64, out: &mut [usize]) -> usize;
+}
+
+/// A [`CountPass`] with its arguments, for `pulp`'s dispatch.
+struct Pass<'a, K> {
+    k: K,
+    weights: &'a [f64],
+    first: usize,
+    cum: f64,
+    out: &'a mut [usize],
+}
+
+impl<K: CountPass> WithSimd for Pass<'_, K> {
+    type Output = usize;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _simd: S) -> usize {
+        self.k.run(self.weights, self.first, self.cum, self.out)
+    }
+}
+
+/// Runs the pass compiled for the widest instruction set the processor offers (`pulp`'s
+/// run-time dispatch: AVX-512, AVX2 with fused multiply-adds, or the baseline), where a batch
+/// of counts is a few vector operations and a run of [`RUN`] slots one vector store.
+pub(super) fn dispatch_pass<K: CountPass>(
+    k: K,
+    weights: &[f64],
+    first: usize,
+    cum: f64,
+    out: &mut [usize],
+) -> usize {
+    Arch::new().dispatch(Pass {
+        k,
+        weights,
+        first,
+        cum,
+        out,
+    })
 }

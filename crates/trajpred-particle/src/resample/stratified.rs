@@ -3,7 +3,6 @@
 use super::Resampler;
 use super::common::*;
 use crate::error::Result;
-use pulp::{Arch, Simd, WithSimd};
 use rand::Rng;
 use trajpred_core::Error as CoreError;
 
@@ -82,9 +81,6 @@ impl Resampler for Stratified {
     }
 }
 
-/// Particles per batch of [`StratifiedCount::run`].
-const BATCH: usize = 64;
-
 /// SplitMix64's increment (the golden ratio in 64 bits).
 const GOLDEN: u64 = 0x9E37_79B9_7F4A_7C15;
 
@@ -144,34 +140,16 @@ pub(super) fn stratified_counts(weights: &[f64], c: Checked, key: u64, out: &mut
         let (first, second) = out.split_at_mut(k_mid);
         join_here(
             || {
-                k.dispatch(&weights[..h], 0, 0.0, first);
+                dispatch_pass(k, &weights[..h], 0, 0.0, first);
             },
             || {
-                let end = k.dispatch(&weights[h..=c.last], h, c.mid_sum, second);
+                let end = dispatch_pass(k, &weights[h..=c.last], h, c.mid_sum, second);
                 second[end..].fill(c.last);
             },
         );
     } else {
-        let end = k.dispatch(&weights[..=c.last], 0, 0.0, out);
+        let end = dispatch_pass(k, &weights[..=c.last], 0, 0.0, out);
         out[end..].fill(c.last);
-    }
-}
-
-/// [`StratifiedCount::run`] compiled for the widest instruction set the processor offers
-/// (`pulp`'s run-time dispatch), where a run of [`RUN`] slots is one vector store.
-struct Run<'a> {
-    k: StratifiedCount,
-    weights: &'a [f64],
-    first: usize,
-    cum: f64,
-    out: &'a mut [usize],
-}
-
-impl WithSimd for Run<'_> {
-    type Output = usize;
-    #[inline(always)]
-    fn with_simd<S: Simd>(self, _simd: S) -> usize {
-        self.k.run(self.weights, self.first, self.cum, self.out)
     }
 }
 
@@ -184,17 +162,6 @@ pub(super) struct StratifiedCount {
 }
 
 impl StratifiedCount {
-    /// [`run`](Self::run), dispatched.
-    fn dispatch(&self, weights: &[f64], first: usize, cum: f64, out: &mut [usize]) -> usize {
-        Arch::new().dispatch(Run {
-            k: *self,
-            weights,
-            first,
-            cum,
-            out,
-        })
-    }
-
     /// `#{j < n : j + u_j < cum n / W}`.
     #[inline(always)]
     fn count(&self, cum: f64) -> usize {
@@ -211,17 +178,18 @@ impl StratifiedCount {
         let frac = x - floor;
         (j0 + usize::from(stratum_uniform(self.key, j0) < frac)).min(self.n)
     }
+}
 
+impl CountPass for StratifiedCount {
     /// Writes the slots of the particles `first..first + weights.len()` (whose running sum
     /// starts at `cum`) into `out`, which starts at the slot `count(cum)`; returns the end of
     /// the written slots, relative to `out`.
     #[inline(always)]
     fn run(&self, weights: &[f64], first: usize, mut cum: f64, out: &mut [usize]) -> usize {
         let base = if first == 0 { 0 } else { self.count(cum) };
-        let len = out.len();
         let mut start = 0usize;
-        // the counts of a batch first (independent of each other but for the running sum,
-        // so the hash of one overlaps the next), then its runs
+        // the counts of a batch first (independent of each other but for the running sum),
+        // then its runs
         let mut ks = [0usize; BATCH];
         let mut cums = [0.0f64; BATCH];
         for (b, batch) in weights.chunks(BATCH).enumerate() {
@@ -233,28 +201,7 @@ impl StratifiedCount {
             for (k, &c) in ks.iter_mut().zip(&cums) {
                 *k = self.count(c);
             }
-            let first = first + b * BATCH;
-            let ks = &ks[..batch.len()];
-            // the counts are non-decreasing: where the batch's last one leaves room for a
-            // run's fixed-width store, no count needs the clamps
-            if ks[0] >= base && ks[ks.len() - 1] - base + RUN <= len {
-                for (s, &k) in ks.iter().enumerate() {
-                    let k = k - base;
-                    if k - start <= RUN {
-                        out[start..start + RUN].copy_from_slice(&[first + s; RUN]);
-                    } else {
-                        out[start..k].fill(first + s);
-                    }
-                    start = k;
-                }
-            } else {
-                for (s, &k) in ks.iter().enumerate() {
-                    // non-decreasing, so at least `start`
-                    let k = k.saturating_sub(base).min(len);
-                    fill_run(out, start, k, first + s);
-                    start = k;
-                }
-            }
+            write_runs(&ks[..batch.len()], base, first + b * BATCH, &mut start, out);
         }
         start
     }

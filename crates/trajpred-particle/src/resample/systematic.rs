@@ -3,7 +3,6 @@
 use super::Resampler;
 use super::common::*;
 use crate::error::Result;
-use pulp::{Arch, Simd, WithSimd};
 use rand::{Rng, RngExt};
 
 /// Systematic resampling for a given offset `u in [0, 1]`: positions `(j + u) / n`
@@ -59,15 +58,15 @@ pub(super) fn systematic_counts(weights: &[f64], c: Checked, offset: f64, out: &
         let (first, second) = out.split_at_mut(k_mid);
         join_here(
             || {
-                k.dispatch(&weights[..h], 0, 0.0, first);
+                dispatch_pass(k, &weights[..h], 0, 0.0, first);
             },
             || {
-                let end = k.dispatch(&weights[h..=c.last], h, c.mid_sum, second);
+                let end = dispatch_pass(k, &weights[h..=c.last], h, c.mid_sum, second);
                 second[end - k_mid..].fill(c.last);
             },
         );
     } else {
-        let end = k.dispatch(&weights[..=c.last], 0, 0.0, out);
+        let end = dispatch_pass(k, &weights[..=c.last], 0, 0.0, out);
         out[end..].fill(c.last);
     }
 }
@@ -118,7 +117,9 @@ impl SystematicCount {
         }
         k
     }
+}
 
+impl CountPass for SystematicCount {
     /// Writes the slots of the particles `first..first + weights.len()` (whose running sum
     /// starts at `cum`) into `out`, which holds the slots from `k` of particle `first - 1`
     /// (0 for the first particle) on; returns `k` of the last particle, in absolute slots.
@@ -130,7 +131,6 @@ impl SystematicCount {
     #[inline(always)]
     fn run(&self, weights: &[f64], first: usize, mut cum: f64, out: &mut [usize]) -> usize {
         let base = if first == 0 { 0 } else { self.count(cum, 0) };
-        let len = out.len();
         let mut start = 0usize;
         let mut prev = base;
         let mut ks = [0usize; BATCH];
@@ -153,62 +153,10 @@ impl SystematicCount {
                     *k = prev;
                 }
             }
-            let ks = &ks[..m];
             prev = ks[m - 1];
-            let first = first + b * BATCH;
-            if ks[0] >= base && ks[m - 1] - base + RUN <= len {
-                for (s, &k) in ks.iter().enumerate() {
-                    let k = k - base;
-                    if k - start <= RUN {
-                        out[start..start + RUN].copy_from_slice(&[first + s; RUN]);
-                    } else {
-                        out[start..k].fill(first + s);
-                    }
-                    start = k;
-                }
-            } else {
-                for (s, &k) in ks.iter().enumerate() {
-                    let k = k.saturating_sub(base).min(len);
-                    fill_run(out, start, k, first + s);
-                    start = k;
-                }
-            }
+            write_runs(&ks[..m], base, first + b * BATCH, &mut start, out);
         }
         start + base
-    }
-}
-
-/// Particles per batch of [`SystematicCount::run`].
-const BATCH: usize = 64;
-
-/// [`SystematicCount::run`] compiled for the widest instruction set the processor offers
-/// (`pulp`'s run-time dispatch), where a run of [`RUN`] slots is one vector store.
-struct Run<'a> {
-    k: SystematicCount,
-    weights: &'a [f64],
-    first: usize,
-    cum: f64,
-    out: &'a mut [usize],
-}
-
-impl WithSimd for Run<'_> {
-    type Output = usize;
-    #[inline(always)]
-    fn with_simd<S: Simd>(self, _simd: S) -> usize {
-        self.k.run(self.weights, self.first, self.cum, self.out)
-    }
-}
-
-impl SystematicCount {
-    /// [`run`](Self::run), dispatched.
-    fn dispatch(&self, weights: &[f64], first: usize, cum: f64, out: &mut [usize]) -> usize {
-        Arch::new().dispatch(Run {
-            k: *self,
-            weights,
-            first,
-            cum,
-            out,
-        })
     }
 }
 
