@@ -450,7 +450,10 @@ pub(super) fn run_parts(weights: &[f64], scale: f64, parts: &[Part], out: &mut [
         _ => {
             let (left, right) = parts.split_at(parts.len() / 2);
             let (a, b) = out.split_at_mut(left.iter().map(Part::slots).sum());
-            join_here(
+            // `rayon::join`, not `join_here`: the parts recurse, and from outside the pool
+            // `join_here` would run the caller's thread beside both workers (three threads
+            // on two cores; measured slower, docs/particle.md)
+            rayon::join(
                 || run_parts(weights, scale, left, a),
                 || run_parts(weights, scale, right, b),
             );
