@@ -138,7 +138,7 @@ pub(super) fn ceil_near(h: f64, margin: f64) -> (usize, bool) {
 }
 
 /// Particles (and output slots) from which [`systematic_counts`] splits its pass in two
-/// halves run by `rayon::join`.
+/// halves run at once ([`join_here`]); stratified uses the same threshold.
 pub(super) const PARALLEL_MIN: usize = 1 << 17;
 
 /// Runs `a` on the calling thread and `b` on rayon's pool at the same time, returning when
@@ -150,6 +150,10 @@ pub(super) const PARALLEL_MIN: usize = 1 << 17;
 /// that failed in most calls after a millisecond of single-threaded work (two 1 ms halves
 /// took 2.1 ms, in sequence), while a job queued from the calling thread, which then works
 /// on its own half, was picked up in time (1.1 ms). Inside the pool both behave alike.
+///
+/// For two halves only: a pass that splits further (residual's parts) keeps `rayon::join`,
+/// since the caller's thread would otherwise work beside every worker (three threads on two
+/// cores, measured slower in docs/particle.md).
 pub(super) fn join_here(a: impl FnOnce(), b: impl FnOnce() + Send) {
     rayon::in_place_scope(|s| {
         s.spawn(|_| b());
