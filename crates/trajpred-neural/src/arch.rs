@@ -6,6 +6,7 @@
 
 use crate::config::{Activation, TrainConfig};
 use crate::error::{CoreError, NeuralError, Result};
+use crate::fused::recurrent::{self, Cell};
 use burn::module::Module;
 use burn::nn::{Linear, LinearConfig, Rnn, RnnConfig};
 use burn::tensor::activation::{relu, sigmoid, tanh};
@@ -266,6 +267,8 @@ pub struct LstmArch(pub RecurrentLayers);
 pub struct RnnStack {
     layers: Vec<Rnn>,
     head: Head,
+    /// Each layer through one fused op (`src/fused/recurrent.rs`) instead of step by step.
+    fused: bool,
 }
 
 /// Stacked LSTM layers and a head.
@@ -273,7 +276,7 @@ pub struct RnnStack {
 pub struct LstmStack {
     layers: Vec<FusedLstm>,
     head: Head,
-    /// Each layer through one fused op (`src/fused/lstm.rs`) instead of step by step.
+    /// Each layer through one fused op (`src/fused/recurrent.rs`) instead of step by step.
     fused: bool,
 }
 
@@ -417,17 +420,53 @@ impl FusedLstm {
     }
 }
 
-/// The last hidden state of stacked layers, each layer one fused op over the window (the
-/// top one returning its last step only); `None` when the tensors are not on the flex
-/// backend, or there is no layer or no step (then the composed path runs).
-fn fused_stack(layers: &[FusedLstm], mut x: Tensor<3>) -> Option<Tensor<2>> {
-    let (top, below) = layers.split_last()?;
-    for l in below {
-        let (w_ih, b, w_hh) = l.fused_params();
-        x = crate::fused::lstm::layer(x, w_ih, b, w_hh).ok()?;
+/// The weights of a layer as the fused ops take them: `W_ih` `[d_input, G]`, `b` `[G]`,
+/// `W_hh` `[hidden, G]`.
+type FusedParams = (Tensor<2>, Tensor<1>, Tensor<2>);
+
+/// The last hidden state of stacked layers of cell `cell`, each layer one fused op over the
+/// window (the top one returning its last step only); `None` when the tensors are not on
+/// the flex backend, or there is no layer or no step (then the composed path runs).
+fn fused_stack(cell: Cell, layers: Vec<FusedParams>, mut x: Tensor<3>) -> Option<Tensor<2>> {
+    let mut layers = layers.into_iter().peekable();
+    while let Some((w_ih, b, w_hh)) = layers.next() {
+        if layers.peek().is_none() {
+            return recurrent::layer_last(cell, x, w_ih, b, w_hh).ok();
+        }
+        x = recurrent::layer(cell, x, w_ih, b, w_hh).ok()?;
     }
-    let (w_ih, b, w_hh) = top.fused_params();
-    crate::fused::lstm::layer_last(x, w_ih, b, w_hh).ok()
+    None
+}
+
+fn lstm_params(layers: &[FusedLstm]) -> Vec<FusedParams> {
+    layers.iter().map(FusedLstm::fused_params).collect()
+}
+
+/// The weights of burn's Elman layers for [`fused_stack`] (`b` the sum of the input and
+/// hidden biases, which burn adds at every step, the first too); `None` when a layer
+/// clips its state or does not use `tanh`, which the fused op does not do.
+fn rnn_params(layers: &[Rnn]) -> Option<Vec<FusedParams>> {
+    layers
+        .iter()
+        .map(|l| {
+            if l.clip.is_some()
+                || !matches!(
+                    l.hidden_activation,
+                    burn::nn::activation::Activation::Tanh(_)
+                )
+            {
+                return None;
+            }
+            let (wi, wh) = (&l.gate.input_transform, &l.gate.hidden_transform);
+            let w_ih = wi.weight.val();
+            let b = match (&wi.bias, &wh.bias) {
+                (Some(a), Some(b)) => a.val() + b.val(),
+                (Some(a), None) | (None, Some(a)) => a.val(),
+                (None, None) => Tensor::zeros([l.d_hidden], &w_ih.device()),
+            };
+            Some((w_ih, b, wh.weight.val()))
+        })
+        .collect()
 }
 
 impl Architecture for RnnArch {
@@ -440,9 +479,34 @@ impl Architecture for RnnArch {
         let (layers, head) = self.0.build(features, outputs, device, |d, h| {
             RnnConfig::new(d, h, true).init(device)
         });
-        RnnStack { layers, head }
+        RnnStack {
+            layers,
+            head,
+            fused: true,
+        }
+    }
+    fn configure(&self, mut net: RnnStack, train: &TrainConfig) -> RnnStack {
+        net.fused = train.fused;
+        net
+    }
+    /// With the fused ops, the stacked layers and then the head and the loss, each one op.
+    fn loss(&self, net: &RnnStack, x: Tensor<3>, y: Tensor<2>) -> Tensor<1> {
+        if net.fused
+            && let Some(params) = rnn_params(&net.layers)
+            && let Some(h) = fused_stack(Cell::Elman, params, x.clone())
+            && let Some(loss) = net.head.fused_mse(h, y.clone())
+        {
+            return loss;
+        }
+        crate::train::mse(self.forward(net, x), y)
     }
     fn forward(&self, net: &RnnStack, mut x: Tensor<3>) -> Tensor<2> {
+        if net.fused
+            && let Some(params) = rnn_params(&net.layers)
+            && let Some(h) = fused_stack(Cell::Elman, params, x.clone())
+        {
+            return net.head.forward(h);
+        }
         let [b, _, _] = x.dims();
         let mut last = None;
         for l in &net.layers {
@@ -481,7 +545,7 @@ impl Architecture for LstmArch {
     /// With the fused ops, the stacked layers and then the head and the loss, each one op.
     fn loss(&self, net: &LstmStack, x: Tensor<3>, y: Tensor<2>) -> Tensor<1> {
         if net.fused
-            && let Some(h) = fused_stack(&net.layers, x.clone())
+            && let Some(h) = fused_stack(Cell::Lstm, lstm_params(&net.layers), x.clone())
             && let Some(loss) = net.head.fused_mse(h, y.clone())
         {
             return loss;
@@ -493,7 +557,7 @@ impl Architecture for LstmArch {
     /// sequence of hidden states is stacked and sliced again.
     fn forward(&self, net: &LstmStack, x: Tensor<3>) -> Tensor<2> {
         if net.fused
-            && let Some(h) = fused_stack(&net.layers, x.clone())
+            && let Some(h) = fused_stack(Cell::Lstm, lstm_params(&net.layers), x.clone())
         {
             return net.head.forward(h);
         }

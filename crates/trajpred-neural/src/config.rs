@@ -78,9 +78,9 @@ pub struct TrainConfig {
     pub early_stopping: Option<EarlyStopping>,
     /// Optional clipping of the gradient's global L2 norm.
     pub grad_clip_norm: Option<f64>,
-    /// Whether the LSTM and the KFU-LSTM-Net run through the fused ops with their own
-    /// backward pass (one autodiff node per LSTM layer / per unrolled filter, one for the
-    /// windowed LSTM's head and loss) instead of burn's per-operation autodiff, the
+    /// Whether the LSTM, the Elman RNN and the KFU-LSTM-Net run through the fused ops with
+    /// their own backward pass (one autodiff node per recurrent layer / per unrolled filter,
+    /// one for the windowed recurrent models' head and loss) instead of burn's per-operation autodiff, the
     /// reference; with it, Adam runs in one loop per parameter (burn's updates bit for bit).
     /// The same weights give the same predictions either way up to `f32` rounding (see
     /// `docs/neural.md`). Default `true`; for the other models it switches Adam's loop
@@ -109,7 +109,7 @@ impl TrainConfig {
     }
 
     setters! {
-        /// Turns the fused LSTM / KFU ops on or off (off: burn's per-operation autodiff).
+        /// Turns the fused LSTM / RNN / KFU ops on or off (off: burn's per-operation autodiff).
         with_fused(fused: bool) => self.fused = fused;
         /// Sets the number of epochs.
         with_epochs(epochs: usize) => self.epochs = epochs;

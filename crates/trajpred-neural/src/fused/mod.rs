@@ -5,12 +5,12 @@
 //! is a tracked tensor, activations are recomputed in the backward pass, and every
 //! operation allocates. Here a whole recurrent computation is **one** node of burn's graph:
 //!
-//! - [`lstm`]: one LSTM layer over a whole sequence. The input projection of every step is
-//!   one matrix product, the recurrent part runs step by step and keeps the activated
-//!   gates, backpropagation through time is written out, and the weight gradients are one
-//!   matrix product each at the end. The windowed model's top layer returns its last step
-//!   only ([`lstm::layer_last`]).
-//! - [`head`]: the windowed LSTM model's fully connected head and its mean squared error
+//! - [`recurrent`]: one LSTM or Elman RNN layer over a whole sequence. The input
+//!   projection of every step is one matrix product, the recurrent part runs step by step
+//!   and keeps the activated gates, backpropagation through time is written out, and the
+//!   weight gradients are one matrix product each at the end. The windowed models' top
+//!   layer returns its last step only ([`recurrent::layer_last`]).
+//! - [`head`]: the windowed recurrent models' fully connected head and its mean squared error
 //!   (the training loss of a batch) as one op.
 //! - [`kfu`]: the whole unrolled Kalman-filter-unfolded LSTM (stacked LSTM transition,
 //!   fully connected head, diagonal Kalman update with learnable `Q`, `R`) over a sequence.
@@ -27,7 +27,7 @@ pub(crate) mod adam;
 pub(crate) mod bridge;
 pub(crate) mod head;
 pub(crate) mod kfu;
-pub(crate) mod lstm;
+pub(crate) mod recurrent;
 mod small;
 #[cfg(test)]
 mod tests;

@@ -1,11 +1,12 @@
 //! The checks of the fused ops: over random shapes, seeds, weights and inputs, every
 //! gradient of every fused op equals burn's autodiff through the composed reference
-//! (`FusedLstm::forward`, `KfuCell::run` without a spec) within `1e-5` of the largest
+//! (`FusedLstm::forward`, burn's `nn::Rnn`, `KfuCell::run` without a spec) within `1e-5` of the largest
 //! magnitude of that gradient (f32); the backward passes equal central finite differences
 //! of the forward passes in f64; and the outputs agree within `1e-5` (f32).
 
-use super::{adam, head, kfu, lstm};
-use crate::arch::{Architecture, FusedLstm, LstmArch, RecurrentLayers};
+use super::recurrent::{self, Cell};
+use super::{adam, head, kfu};
+use crate::arch::{Architecture, FusedLstm, LstmArch, RecurrentLayers, RnnArch};
 use crate::config::{Activation, TrainConfig};
 use crate::kfu::{KfuCell, KfuConfig};
 use crate::train::{device, read, rng};
@@ -120,7 +121,8 @@ fn lstm_layer_gradients_equal_the_composed_reference() {
         let x_fused = tensor(xv, [b, t, d], &device).require_grad();
         let (out_ref, _) = layer.forward(x_ref.clone(), None);
         let (w_ih, bias, w_hh) = layer.fused_params();
-        let out = lstm::layer(x_fused.clone(), w_ih, bias, w_hh).expect("flex tensors");
+        let out =
+            recurrent::layer(Cell::Lstm, x_fused.clone(), w_ih, bias, w_hh).expect("flex tensors");
         let what = format!("seed {seed}: B {b} T {t} D {d} H {h}");
         assert_close(
             &read(out.clone()).expect("f32"),
@@ -156,19 +158,33 @@ fn collect<M: Module>(grads: &GradientsParams, module: &M) -> Vec<Vec<f32>> {
     c.out
 }
 
-/// Stacked layers and a head (the windowed LSTM model's network): fused and composed
-/// forward passes give the same outputs and the same gradient of every parameter.
+/// Stacked layers and a head (the windowed LSTM and RNN models' networks): fused and
+/// composed forward passes give the same outputs and the same gradient of every parameter.
 #[test]
 fn lstm_stack_gradients_equal_the_composed_reference() {
+    stack_gradients_equal_the_composed_reference(LstmArch, 8);
+}
+
+/// [`lstm_stack_gradients_equal_the_composed_reference`] for the Elman RNN (burn's
+/// `nn::Rnn` the reference).
+#[test]
+fn rnn_stack_gradients_equal_the_composed_reference() {
+    stack_gradients_equal_the_composed_reference(RnnArch, 18);
+}
+
+fn stack_gradients_equal_the_composed_reference<A: Architecture>(
+    make: fn(RecurrentLayers) -> A,
+    stream: u64,
+) {
     let device = device();
     for seed in 0..10u64 {
-        let mut r = rng(seed, 8);
+        let mut r = rng(seed, stream);
         let n_layers = r.random_range(1..4);
         let layers: Vec<usize> = (0..n_layers).map(|_| r.random_range(1..9)).collect();
         let fc: Vec<usize> = (0..r.random_range(0..2))
             .map(|_| r.random_range(1..6))
             .collect();
-        let arch = LstmArch(RecurrentLayers {
+        let arch = make(RecurrentLayers {
             layers,
             fc,
             activation: Activation::Tanh,
@@ -312,35 +328,38 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-/// The LSTM layer's backward pass equals finite differences of its forward pass (f64), from
-/// the gradient of every hidden state (even seeds) or of the last step's only (odd seeds).
+/// The recurrent layer's backward pass equals finite differences of its forward pass (f64),
+/// from the gradient of every hidden state (even seeds) or of the last step's only (odd
+/// seeds); LSTM cells for the first six seeds, Elman cells for the next six.
 #[test]
-fn lstm_backward_equals_finite_differences() {
-    for seed in 0..6u64 {
+fn recurrent_backward_equals_finite_differences() {
+    for seed in 0..12u64 {
         let mut r = rng(seed, 10);
-        let dims = lstm::Dims {
+        let dims = recurrent::Dims {
             batch: r.random_range(1..4),
             steps: r.random_range(1..5),
             input: r.random_range(1..4),
             hidden: r.random_range(1..4),
+            cell: if seed < 6 { Cell::Lstm } else { Cell::Elman },
         };
         let (b, t, d, h) = (dims.batch, dims.steps, dims.input, dims.hidden);
+        let g = dims.cell.blocks() * h;
         let x = uniform64(&mut r, b * t * d, 1.5);
-        let w_ih = uniform64(&mut r, d * 4 * h, 0.7);
-        let bias = uniform64(&mut r, 4 * h, 0.7);
-        let w_hh = uniform64(&mut r, h * 4 * h, 0.7);
+        let w_ih = uniform64(&mut r, d * g, 0.7);
+        let bias = uniform64(&mut r, g, 0.7);
+        let w_hh = uniform64(&mut r, h * g, 0.7);
         let last = seed % 2 == 1;
         let w = uniform64(&mut r, b * if last { 1 } else { t } * h, 1.0);
-        let cache = lstm::forward(dims, &x, &w_ih, &bias, &w_hh).expect("shapes");
+        let cache = recurrent::forward(dims, &x, &w_ih, &bias, &w_hh).expect("shapes");
         let dh = if last {
-            lstm::OutGrad::Last(&w)
+            recurrent::OutGrad::Last(&w)
         } else {
-            lstm::OutGrad::All(&w)
+            recurrent::OutGrad::All(&w)
         };
-        let g = lstm::backward(&cache, &w_ih, &w_hh, dh, true).expect("shapes");
+        let g = recurrent::backward(&cache, &w_ih, &w_hh, dh, true).expect("shapes");
         let what = format!("seed {seed}: {dims:?}, last step only: {last}");
         let f = |x: &[f64], wi: &[f64], bb: &[f64], wh: &[f64]| {
-            let c = lstm::forward(dims, x, wi, bb, wh).expect("shapes");
+            let c = recurrent::forward(dims, x, wi, bb, wh).expect("shapes");
             if last {
                 dot(c.last(), &w)
             } else {
@@ -368,11 +387,24 @@ fn lstm_backward_equals_finite_differences() {
 /// every parameter, of the input windows and of the targets.
 #[test]
 fn lstm_loss_gradients_equal_the_composed_reference() {
+    loss_gradients_equal_the_composed_reference(LstmArch, 14);
+}
+
+/// [`lstm_loss_gradients_equal_the_composed_reference`] for the windowed Elman RNN model.
+#[test]
+fn rnn_loss_gradients_equal_the_composed_reference() {
+    loss_gradients_equal_the_composed_reference(RnnArch, 19);
+}
+
+fn loss_gradients_equal_the_composed_reference<A: Architecture>(
+    make: fn(RecurrentLayers) -> A,
+    stream: u64,
+) {
     let device = device();
     let acts = [Activation::Relu, Activation::Tanh, Activation::Sigmoid];
     for seed in 0..12u64 {
-        let mut r = rng(seed, 14);
-        let arch = LstmArch(RecurrentLayers {
+        let mut r = rng(seed, stream);
+        let arch = make(RecurrentLayers {
             layers: (0..r.random_range(1..4))
                 .map(|_| r.random_range(1..9))
                 .collect(),
@@ -520,7 +552,7 @@ fn plain_weights_with_autodiff_data_run_fused() {
         .valid();
     let x = tensor(uniform(&mut r, 2 * 4 * 2, 1.0), [2, 4, 2], &device);
     let (w_ih, bias, w_hh) = layer.fused_params();
-    let out = lstm::layer(x.clone(), w_ih, bias, w_hh).expect("runs fused");
+    let out = recurrent::layer(Cell::Lstm, x.clone(), w_ih, bias, w_hh).expect("runs fused");
     let (out_ref, _) = layer.forward(x, None);
     assert_close(
         &read(out).expect("f32"),

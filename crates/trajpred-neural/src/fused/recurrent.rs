@@ -1,29 +1,65 @@
-//! One LSTM layer over a whole sequence as one autodiff op (zero initial state).
+//! One recurrent layer (LSTM or Elman) over a whole sequence as one autodiff op (zero
+//! initial state).
 //!
-//! Forward: the input projection of every step in one product `X W_ih + b` (`[T B, 4H]`,
-//! time-major), then per step `a_t += h_{t-1} W_hh`, the gates activated in place and kept.
-//! Backward: backpropagation through time over the kept gates, the pre-activation
-//! gradients of every step collected in `dA` (`[T B, 4H]`); then `dW_ih = Xᵀ dA`,
-//! `dW_hh = H_{prev}ᵀ dA`, `db = Σ dA`, `dX = dA W_ihᵀ`, one product each.
+//! Forward: the input projection of every step in one product `X W_ih + b` (`[T B, G]`,
+//! time-major, `G = 4H` gates for the LSTM, `G = H` for the Elman cell), then per step
+//! `a_t += h_{t-1} W_hh`, the gates activated in place and kept. Backward:
+//! backpropagation through time over the kept gates, the pre-activation gradients of every
+//! step collected in `dA` (`[T B, G]`); then `dW_ih = Xᵀ dA`, `dW_hh = H_{prev}ᵀ dA`,
+//! `db = Σ dA`, `dX = dA W_ihᵀ`, one product each.
 
 use super::bridge;
-use super::{Mat, Real, add_column_sums, cell_backward, cell_forward, gemm};
+use super::{Mat, Real, add_column_sums, cell_backward, cell_forward, gemm, tanh};
 use crate::error::{CoreError, NeuralError, Result};
 use burn::backend::flex::FlexTensor;
 use burn::tensor::Tensor;
 
-/// Sizes of a layer run: batch, steps, input features, hidden units.
+/// The cell of a layer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Cell {
+    /// LSTM, four gate blocks `[i f g o]` in PyTorch's order ([`cell_forward`]).
+    Lstm,
+    /// Elman: `h_t = tanh(a_t)`, one block (burn's `nn::Rnn` with its default `tanh` and no
+    /// clipping).
+    Elman,
+}
+
+impl Cell {
+    /// Gate blocks per hidden unit.
+    pub(crate) fn blocks(self) -> usize {
+        match self {
+            Cell::Lstm => 4,
+            Cell::Elman => 1,
+        }
+    }
+}
+
+/// Sizes of a layer run: batch, steps, input features, hidden units, and the cell.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Dims {
     pub batch: usize,
     pub steps: usize,
     pub input: usize,
     pub hidden: usize,
+    pub cell: Cell,
 }
 
 impl Dims {
     fn rows(&self) -> usize {
         self.batch * self.steps
+    }
+
+    /// Gate values per row: `4H` (LSTM) or `H` (Elman).
+    fn gates(&self) -> usize {
+        self.cell.blocks() * self.hidden
+    }
+
+    /// Values per row of the cell-state buffers (none for the Elman cell).
+    fn cell_width(&self) -> usize {
+        match self.cell {
+            Cell::Lstm => self.hidden,
+            Cell::Elman => 0,
+        }
     }
 }
 
@@ -33,11 +69,11 @@ pub(crate) struct Cache<T> {
     pub dims: Dims,
     /// The inputs `[T B, D]`.
     xt: Vec<T>,
-    /// The activated gates `[T B, 4H]`.
+    /// The activated gates `[T B, G]`.
     gates: Vec<T>,
-    /// Cell states `[T B, H]`.
+    /// Cell states `[T B, H]` (empty for the Elman cell).
     cs: Vec<T>,
-    /// `tanh` of the cell states `[T B, H]`.
+    /// `tanh` of the cell states `[T B, H]` (empty for the Elman cell).
     tcs: Vec<T>,
     /// Hidden states `[T B, H]`.
     hs: Vec<T>,
@@ -48,11 +84,11 @@ pub(crate) struct Cache<T> {
 pub(crate) struct Grads<T> {
     /// `[B, T, D]`, when asked for.
     pub dx: Option<Vec<T>>,
-    /// `[D, 4H]`.
+    /// `[D, G]`.
     pub dw_ih: Vec<T>,
-    /// `[4H]`.
+    /// `[G]`.
     pub db: Vec<T>,
-    /// `[H, 4H]`.
+    /// `[H, G]`.
     pub dw_hh: Vec<T>,
 }
 
@@ -98,7 +134,7 @@ impl<T: Copy> Cache<T> {
     }
 }
 
-/// The forward pass: `x` `[B, T, D]`, `w_ih` `[D, 4H]`, `b` `[4H]`, `w_hh` `[H, 4H]`;
+/// The forward pass: `x` `[B, T, D]`, `w_ih` `[D, G]`, `b` `[G]`, `w_hh` `[H, G]`;
 /// returns the cache of the backward pass, which holds the hidden states
 /// ([`Cache::output`], [`Cache::last`]).
 pub(crate) fn forward<T: Real>(
@@ -113,47 +149,55 @@ pub(crate) fn forward<T: Real>(
         steps,
         input,
         hidden,
+        cell,
     } = dims;
-    let g4 = 4 * hidden;
-    check_len(x, dims.rows() * input, "fused LSTM input")?;
-    check_len(w_ih, input * g4, "fused LSTM input weights")?;
-    check_len(b, g4, "fused LSTM bias")?;
-    check_len(w_hh, hidden * g4, "fused LSTM recurrent weights")?;
+    let g = dims.gates();
+    check_len(x, dims.rows() * input, "fused recurrent layer input")?;
+    check_len(w_ih, input * g, "fused recurrent layer input weights")?;
+    check_len(b, g, "fused recurrent layer bias")?;
+    check_len(w_hh, hidden * g, "fused recurrent layer recurrent weights")?;
     let xt = swap_01(x, batch, steps, input);
     let rows = dims.rows();
-    let mut gates = Vec::with_capacity(rows * g4);
+    let mut gates = Vec::with_capacity(rows * g);
     for _ in 0..rows {
         gates.extend_from_slice(b);
     }
     gemm(
         Mat::new(&xt, rows, input),
-        Mat::new(w_ih, input, g4),
+        Mat::new(w_ih, input, g),
         T::one(),
         &mut gates,
     )?;
     let zero = T::zero();
-    let mut cs = vec![zero; rows * hidden];
-    let mut tcs = vec![zero; rows * hidden];
+    let cw = rows * dims.cell_width();
+    let (mut cs, mut tcs) = (vec![zero; cw], vec![zero; cw]);
     let mut hs = vec![zero; rows * hidden];
-    let (bh, bg) = (batch * hidden, batch * g4);
+    let (bh, bg) = (batch * hidden, batch * g);
     for t in 0..steps {
         let (h_done, h_rest) = hs.split_at_mut(t * bh);
-        let (c_done, c_rest) = cs.split_at_mut(t * bh);
         let a = &mut gates[t * bg..(t + 1) * bg];
-        let c_prev = if t > 0 {
-            T::step_mul_add(&h_done[(t - 1) * bh..], w_hh, (batch, hidden, g4), a)?;
-            Some(&c_done[(t - 1) * bh..])
-        } else {
-            None
-        };
-        cell_forward(
-            hidden,
-            a,
-            c_prev,
-            &mut c_rest[..bh],
-            &mut tcs[t * bh..(t + 1) * bh],
-            &mut h_rest[..bh],
-        );
+        if t > 0 {
+            T::step_mul_add(&h_done[(t - 1) * bh..], w_hh, (batch, hidden, g), a)?;
+        }
+        match cell {
+            Cell::Lstm => {
+                let (c_done, c_rest) = cs.split_at_mut(t * bh);
+                cell_forward(
+                    hidden,
+                    a,
+                    (t > 0).then(|| &c_done[(t - 1) * bh..]),
+                    &mut c_rest[..bh],
+                    &mut tcs[t * bh..(t + 1) * bh],
+                    &mut h_rest[..bh],
+                );
+            }
+            Cell::Elman => {
+                for (v, h) in a.iter_mut().zip(&mut h_rest[..bh]) {
+                    *v = tanh(*v);
+                    *h = *v;
+                }
+            }
+        }
     }
     Ok(Cache {
         dims,
@@ -183,31 +227,38 @@ pub(crate) fn backward<T: Real>(
     dh: OutGrad<'_, T>,
     need_dx: bool,
 ) -> Result<Grads<T>> {
+    let dims = cache.dims;
     let Dims {
         batch,
         steps,
         input,
         hidden,
-    } = cache.dims;
-    let g4 = 4 * hidden;
-    let rows = cache.dims.rows();
+        cell,
+    } = dims;
+    let g = dims.gates();
+    let rows = dims.rows();
     let zero = T::zero();
-    let (bh, bg) = (batch * hidden, batch * g4);
+    let one = T::one();
+    let (bh, bg) = (batch * hidden, batch * g);
     let dht = match dh {
         OutGrad::All(dh) => {
-            check_len(dh, rows * hidden, "fused LSTM output gradient")?;
+            check_len(dh, rows * hidden, "fused recurrent layer output gradient")?;
             swap_01(dh, batch, steps, hidden)
         }
         OutGrad::Last(dh) => {
-            check_len(dh, bh.min(rows * hidden), "fused LSTM last-step gradient")?;
+            check_len(
+                dh,
+                bh.min(rows * hidden),
+                "fused recurrent layer last-step gradient",
+            )?;
             let mut v = vec![zero; rows * hidden];
             v[rows * hidden - dh.len()..].copy_from_slice(dh);
             v
         }
     };
-    let mut da = vec![zero; rows * g4];
+    let mut da = vec![zero; rows * g];
     let mut dh_next = vec![zero; bh];
-    let mut dc = vec![zero; bh];
+    let mut dc = vec![zero; batch * dims.cell_width()];
     let mut dh_t = vec![zero; bh];
     for t in (0..steps).rev() {
         for ((d, a), n) in dh_t
@@ -217,45 +268,52 @@ pub(crate) fn backward<T: Real>(
         {
             *d = *a + *n;
         }
-        let c_prev = (t > 0).then(|| &cache.cs[(t - 1) * bh..t * bh]);
+        let gates_t = &cache.gates[t * bg..(t + 1) * bg];
         let da_t = &mut da[t * bg..(t + 1) * bg];
-        cell_backward(
-            hidden,
-            &cache.gates[t * bg..(t + 1) * bg],
-            c_prev,
-            &cache.tcs[t * bh..(t + 1) * bh],
-            &dh_t,
-            &mut dc,
-            da_t,
-        );
+        match cell {
+            Cell::Lstm => cell_backward(
+                hidden,
+                gates_t,
+                (t > 0).then(|| &cache.cs[(t - 1) * bh..t * bh]),
+                &cache.tcs[t * bh..(t + 1) * bh],
+                &dh_t,
+                &mut dc,
+                da_t,
+            ),
+            Cell::Elman => {
+                for ((d, &h), &dh) in da_t.iter_mut().zip(gates_t).zip(&dh_t) {
+                    *d = dh * (one - h * h);
+                }
+            }
+        }
         if t > 0 {
-            T::step_mul_t(da_t, w_hh, (batch, g4, hidden), &mut dh_next)?;
+            T::step_mul_t(da_t, w_hh, (batch, g, hidden), &mut dh_next)?;
         }
     }
-    let mut dw_ih = vec![zero; input * g4];
+    let mut dw_ih = vec![zero; input * g];
     gemm(
         Mat::new(&cache.xt, rows, input).t(),
-        Mat::new(&da, rows, g4),
+        Mat::new(&da, rows, g),
         zero,
         &mut dw_ih,
     )?;
-    let mut dw_hh = vec![zero; hidden * g4];
+    let mut dw_hh = vec![zero; hidden * g];
     if steps > 1 {
         let r = (steps - 1) * batch;
         gemm(
             Mat::new(&cache.hs[..r * hidden], r, hidden).t(),
-            Mat::new(&da[batch * g4..], r, g4),
+            Mat::new(&da[batch * g..], r, g),
             zero,
             &mut dw_hh,
         )?;
     }
-    let mut db = vec![zero; g4];
-    add_column_sums(&da, g4, &mut db);
+    let mut db = vec![zero; g];
+    add_column_sums(&da, g, &mut db);
     let dx = if need_dx {
         let mut dxt = vec![zero; rows * input];
         gemm(
-            Mat::new(&da, rows, g4),
-            Mat::new(w_ih, input, g4).t(),
+            Mat::new(&da, rows, g),
+            Mat::new(w_ih, input, g).t(),
             zero,
             &mut dxt,
         )?;
@@ -281,22 +339,18 @@ pub(crate) struct State {
     last: bool,
 }
 
-/// A fused LSTM layer's inputs: `x`, `W_ih`, `b`, `W_hh`.
+/// A fused recurrent layer's inputs: `x`, `W_ih`, `b`, `W_hh`.
 impl bridge::FusedState<4> for State {
-    const WHAT: &'static str = "LSTM output gradient";
+    const WHAT: &'static str = "recurrent layer output gradient";
 
     fn shapes(&self) -> [Vec<usize>; 4] {
-        let Dims {
-            batch,
-            steps,
-            input,
-            hidden,
-        } = self.cache.dims;
+        let dims = self.cache.dims;
+        let g = dims.gates();
         [
-            vec![batch, steps, input],
-            vec![input, 4 * hidden],
-            vec![4 * hidden],
-            vec![hidden, 4 * hidden],
+            vec![dims.batch, dims.steps, dims.input],
+            vec![dims.input, g],
+            vec![g],
+            vec![dims.hidden, g],
         ]
     }
 
@@ -306,40 +360,44 @@ impl bridge::FusedState<4> for State {
         } else {
             OutGrad::All(dh)
         };
-        let w_ih = self.w_ih.values("LSTM input weights")?;
-        let w_hh = self.w_hh.values("LSTM recurrent weights")?;
+        let w_ih = self.w_ih.values("recurrent layer input weights")?;
+        let w_hh = self.w_hh.values("recurrent layer recurrent weights")?;
         let g = backward(&self.cache, &w_ih, &w_hh, dh, need_x)?;
         Ok([g.dx.unwrap_or_default(), g.dw_ih, g.db, g.dw_hh])
     }
 }
 
-/// Runs one LSTM layer (`x` `[B, T, D]`, `w_ih` `[D, 4H]`, `b` `[4H]`, `w_hh` `[H, 4H]`,
-/// zero initial state) as one op; returns the hidden states `[B, T, H]`.
+/// Runs one recurrent layer of cell `cell` (`x` `[B, T, D]`, `w_ih` `[D, G]`, `b` `[G]`,
+/// `w_hh` `[H, G]` with `G` = [`Cell::blocks`] `x H`, zero initial state) as one op;
+/// returns the hidden states `[B, T, H]`.
 ///
 /// Errors when the tensors are not `f32` tensors of the flex backend (then the composed
 /// layer is the way).
 pub(crate) fn layer(
+    cell: Cell,
     x: Tensor<3>,
     w_ih: Tensor<2>,
     b: Tensor<1>,
     w_hh: Tensor<2>,
 ) -> Result<Tensor<3>> {
-    run(x, w_ih, b, w_hh, false)
+    run(cell, x, w_ih, b, w_hh, false)
 }
 
 /// [`layer`] returning the last step's hidden states `[B, H]` only (what the windowed
-/// model's head reads): no slice of the whole sequence, nor its gradient, in burn's graph.
+/// models' head reads): no slice of the whole sequence, nor its gradient, in burn's graph.
 /// Errors also for a sequence without steps.
 pub(crate) fn layer_last(
+    cell: Cell,
     x: Tensor<3>,
     w_ih: Tensor<2>,
     b: Tensor<1>,
     w_hh: Tensor<2>,
 ) -> Result<Tensor<2>> {
-    run(x, w_ih, b, w_hh, true)
+    run(cell, x, w_ih, b, w_hh, true)
 }
 
 fn run<const D: usize>(
+    cell: Cell,
     x: Tensor<3>,
     w_ih: Tensor<2>,
     b: Tensor<1>,
@@ -347,25 +405,26 @@ fn run<const D: usize>(
     last: bool,
 ) -> Result<Tensor<D>> {
     let [batch, steps, input] = x.dims();
-    let [_, g4] = w_ih.dims();
+    let [_, g] = w_ih.dims();
     let dims = Dims {
         batch,
         steps,
         input,
-        hidden: g4 / 4,
+        hidden: g / cell.blocks(),
+        cell,
     };
     if last && steps == 0 {
         return Err(NeuralError::Core(CoreError::DimensionMismatch {
-            what: "fused LSTM steps",
+            what: "fused recurrent layer steps",
             expected: 1,
             got: 0,
         }));
     }
     let prims = vec![
-        bridge::prim(x, "LSTM input")?,
-        bridge::prim(w_ih, "LSTM input weights")?,
-        bridge::prim(b, "LSTM bias")?,
-        bridge::prim(w_hh, "LSTM recurrent weights")?,
+        bridge::prim(x, "recurrent layer input")?,
+        bridge::prim(w_ih, "recurrent layer input weights")?,
+        bridge::prim(b, "recurrent layer bias")?,
+        bridge::prim(w_hh, "recurrent layer recurrent weights")?,
     ];
     let shape: Vec<usize> = if last {
         vec![batch, dims.hidden]
@@ -373,10 +432,10 @@ fn run<const D: usize>(
         vec![batch, steps, dims.hidden]
     };
     let run = |t: &[FlexTensor]| -> Result<(Vec<f32>, State)> {
-        let x = bridge::values(&t[0], "LSTM input")?;
-        let w_ih = bridge::values(&t[1], "LSTM input weights")?;
-        let b = bridge::values(&t[2], "LSTM bias")?;
-        let w_hh = bridge::values(&t[3], "LSTM recurrent weights")?;
+        let x = bridge::values(&t[0], "recurrent layer input")?;
+        let w_ih = bridge::values(&t[1], "recurrent layer input weights")?;
+        let b = bridge::values(&t[2], "recurrent layer bias")?;
+        let w_hh = bridge::values(&t[3], "recurrent layer recurrent weights")?;
         let cache = forward(dims, &x, &w_ih, &b, &w_hh)?;
         let out = if last {
             cache.last().to_vec()
@@ -397,7 +456,7 @@ fn run<const D: usize>(
         bridge::FusedBackward::<State>::new(),
         prims,
         &shape,
-        "fused LSTM",
+        "fused recurrent layer",
         run,
     )
 }
