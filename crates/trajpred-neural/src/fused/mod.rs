@@ -336,27 +336,20 @@ impl<T: Real> pulp::WithSimd for CellForward<'_, T> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        let CellForward {
-            h,
-            a,
-            c_prev,
-            c,
-            tc,
-            hout,
-        } = self;
-        cell_forward_loops(h, a, c_prev, c, tc, hout)
+        cell_forward_loops(self)
     }
 }
 
 #[inline(always)]
-fn cell_forward_loops<T: Real>(
-    h: usize,
-    a: &mut [T],
-    c_prev: Option<&[T]>,
-    c: &mut [T],
-    tc: &mut [T],
-    hout: &mut [T],
-) {
+fn cell_forward_loops<T: Real>(args: CellForward<'_, T>) {
+    let CellForward {
+        h,
+        a,
+        c_prev,
+        c,
+        tc,
+        hout,
+    } = args;
     let g4 = 4 * h;
     let zeros;
     let c_prev = match c_prev {
@@ -440,29 +433,21 @@ impl<T: Real> pulp::WithSimd for CellBackward<'_, T> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        let CellBackward {
-            h,
-            gates,
-            c_prev,
-            tc,
-            dh,
-            dc,
-            da,
-        } = self;
-        cell_backward_loops(h, gates, c_prev, tc, dh, dc, da)
+        cell_backward_loops(self)
     }
 }
 
 #[inline(always)]
-fn cell_backward_loops<T: Real>(
-    h: usize,
-    gates: &[T],
-    c_prev: Option<&[T]>,
-    tc: &[T],
-    dh: &[T],
-    dc: &mut [T],
-    da: &mut [T],
-) {
+fn cell_backward_loops<T: Real>(args: CellBackward<'_, T>) {
+    let CellBackward {
+        h,
+        gates,
+        c_prev,
+        tc,
+        dh,
+        dc,
+        da,
+    } = args;
     let g4 = 4 * h;
     let one = T::one();
     let zeros;
