@@ -21,7 +21,6 @@ use trajpred::predictors::{
 };
 use trajpred::registry::{MethodOptions, build};
 use trajpred_core::{Predictor, Result, Trajectory};
-use trajpred_data::{Frame, LoadOptions, Projection};
 
 fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().collect();
@@ -223,83 +222,6 @@ fn main() -> Result<()> {
                         alpha,
                     }) as Box<dyn Predictor>)
                 })?;
-            }
-        } else if arg(6, "1") == "14" {
-            // where the target is: every track reloaded in one frame shared by all (around
-            // the first training segment's origin), the learners told the last point and
-            // the heading in it; the same users, segments and folds
-            let origin = match train.first().map(|s| s.frame) {
-                Some(Frame::Enu(o)) => o,
-                _ => return Ok(()),
-            };
-            let shared_opts = LoadOptions {
-                projection: Projection::Enu(origin),
-                ..ds.options()
-            };
-            let reloaded = load(ds, path.as_ref(), &shared_opts, &seg, None)?;
-            let (shared_train, _) = split_segments(&reloaded.segments, split)?;
-            assert_eq!(
-                group_ids(&shared_train),
-                groups,
-                "the same users in the same order"
-            );
-            let shared: Vec<Trajectory> =
-                shared_train.iter().map(|s| s.trajectory.clone()).collect();
-            let learner = |which: &str| arg(7, "gbm") == which || arg(7, "gbm") == "both";
-            let score = |name: &str, b: &dyn Fn() -> Result<Box<dyn Predictor>>| -> Result<()> {
-                let s = cross_validate(name, b, &shared, &groups, 5, 0, &eval)?;
-                let f: Vec<String> = s.fold_errors.iter().map(|e| format!("{e:.3}")).collect();
-                eprintln!("| {name} | {:.3} | {} |", s.pooled_error, f.join(", "));
-                Ok(())
-            };
-            if learner("gbm") {
-                for position_features in [false, true] {
-                    let p = AlignedGbmParams {
-                        position_features,
-                        ..Default::default()
-                    };
-                    score(
-                        &format!("aligned-gbm, shared frame, position {position_features}"),
-                        &|| Ok(Box::new(AlignedGbm::new(p.clone())?) as Box<dyn Predictor>),
-                    )?;
-                }
-            }
-            if learner("mlp") {
-                for position_features in [false, true] {
-                    let p = AlignedMlpParams {
-                        position_features,
-                        ..Default::default()
-                    };
-                    score(
-                        &format!("aligned-mlp, shared frame, position {position_features}"),
-                        &|| Ok(Box::new(AlignedMlp::new(p.clone())?) as Box<dyn Predictor>),
-                    )?;
-                }
-            }
-        } else if arg(6, "1") == "15" {
-            // when the target moves: the phase of the origin's time in the day and the week
-            let learner = |which: &str| arg(7, "gbm") == which || arg(7, "gbm") == "both";
-            if learner("gbm") {
-                for clock_features in [false, true] {
-                    gbm(
-                        &format!("aligned-gbm, clock {clock_features}"),
-                        AlignedGbmParams {
-                            clock_features,
-                            ..Default::default()
-                        },
-                    )?;
-                }
-            }
-            if learner("mlp") {
-                for clock_features in [false, true] {
-                    let p = AlignedMlpParams {
-                        clock_features,
-                        ..Default::default()
-                    };
-                    report(&format!("aligned-mlp, clock {clock_features}"), &|| {
-                        Ok(Box::new(AlignedMlp::new(p.clone())?) as Box<dyn Predictor>)
-                    })?;
-                }
             }
         } else if arg(6, "1") == "10" {
             let one = |f: &dyn Fn(&mut AlignedMlpParams)| {

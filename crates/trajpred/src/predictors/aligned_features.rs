@@ -20,15 +20,6 @@ pub(super) struct Layout {
     /// deviation, largest, smallest, median, legs slower than 0.3 m/s; interval: standard
     /// deviation, largest; total turn).
     pub shape: bool,
-    /// With where the window ends and where it heads in the data's own axes: the last
-    /// point (two coordinates) and the unit heading (cos, sin). Only meaningful when every
-    /// track shares one frame (`evaluate --origin`); the only features that are not the
-    /// same for a turned or moved history.
-    pub position: bool,
-    /// With when the window ends: the phase of the origin's time in the day and in the
-    /// week (cos and sin of each, the times read as seconds since 1970-01-01 UTC). The only
-    /// features that are not the same for a history shifted in time.
-    pub clock: bool,
 }
 
 impl Layout {
@@ -36,11 +27,7 @@ impl Layout {
     /// duration of each of the `k` last legs, and the rotated mean velocity of the window;
     /// with the shape features, 18 fitted and 8 spread features more.
     pub(super) fn count(&self) -> usize {
-        3 * self.lags
-            + 4
-            + if self.shape { 26 } else { 0 }
-            + if self.position { 4 } else { 0 }
-            + if self.clock { 4 } else { 0 }
+        3 * self.lags + 4 + if self.shape { 26 } else { 0 }
     }
 
     /// Per feature, `-1` where mirroring the track across its heading negates it (the
@@ -58,13 +45,6 @@ impl Layout {
                 s.extend([1.0, -1.0]);
             }
             s.extend([1.0; 8]);
-        }
-        if self.position {
-            // where the track is cannot be mirrored: the owners refuse `mirror` with it
-            s.extend([1.0; 4]);
-        }
-        if self.clock {
-            s.extend([1.0; 4]);
         }
         s
     }
@@ -110,14 +90,6 @@ impl Origin {
         feats.extend([mean.0, mean.1]);
         if p.shape {
             shape_features(&t[first..=o], &x[first..=o], &y[first..=o], u, &mut feats);
-        }
-        if p.position {
-            feats.extend([x[o], y[o], u.0, u.1]);
-        }
-        if p.clock {
-            let day = std::f64::consts::TAU * (t[o] / 86_400.0).fract();
-            let week = std::f64::consts::TAU * (t[o] / 604_800.0).fract();
-            feats.extend([day.cos(), day.sin(), week.cos(), week.sin()]);
         }
         Origin {
             u,
@@ -373,13 +345,6 @@ impl Layout {
             "horizons": horizons,
             "shape_features": self.shape,
         });
-        // (only when on: files saved before these options stay valid and unchanged)
-        if self.position {
-            v["position_features"] = true.into();
-        }
-        if self.clock {
-            v["clock_features"] = true.into();
-        }
         if base != Base::Velocity {
             // (only then: files saved before the choice stay valid and unchanged)
             v["base"] = base.name().into();
@@ -399,22 +364,8 @@ impl Layout {
     ) -> Result<(At<'a>, Base)> {
         let [lags, window, horizons_at, shape, model] = root.fields_and(
             ["lags", "window", "horizons", "shape_features", key],
-            &["base", "position_features", "clock_features"],
+            &["base"],
         )?;
-        for (key, ours) in [
-            ("position_features", self.position),
-            ("clock_features", self.clock),
-        ] {
-            let saved = match root.optional(key) {
-                None => false,
-                Some(b) => b.bool()?,
-            };
-            if saved != ours {
-                return Err(root.error(format!(
-                    "fitted with {key} {saved}, but this predictor has {ours}"
-                )));
-            }
-        }
         let base = match root.optional("base") {
             None => Base::Velocity,
             Some(b) => Base::parse(&b)?,
@@ -472,8 +423,6 @@ mod tests {
             lags: 8,
             window: 20,
             shape: true,
-            position: false,
-            clock: false,
         };
         let (a, b) = (
             Origin::new(&p, &t, &x, &y, 24),

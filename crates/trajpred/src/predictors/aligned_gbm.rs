@@ -46,19 +46,6 @@ pub struct AlignedGbmParams {
     /// standard deviation, largest, smallest, median, legs slower than 0.3 m/s; interval:
     /// standard deviation, largest; total turn).
     pub shape_features: bool,
-    /// Also describe where the window ends and where it heads in the data's own axes (the
-    /// last point and the unit heading), so that the model can learn where targets go from
-    /// a place: only meaningful when every track shares one frame (`evaluate --origin`),
-    /// and the only features that are not the same for a turned or moved history.
-    /// Default `false`.
-    #[serde(default)]
-    pub position_features: bool,
-    /// Also describe when the window ends: the phase of the origin's time in the day and
-    /// in the week (times read as seconds since 1970-01-01 UTC, as the loaders give them),
-    /// so that the model can learn how targets move at night or at rush hour. Default
-    /// `false`.
-    #[serde(default)]
-    pub clock_features: bool,
     /// Reweighted passes after the first fit: each fits the unclipped targets again,
     /// weighing every origin by `1 / max(r, robust_floor)` (normalised to a mean of 1) with
     /// `r` the Euclidean size of its residual under the previous pass (along and across
@@ -88,8 +75,6 @@ impl Default for AlignedGbmParams {
             clip_quantile: 0.8,
             max_samples: 100_000,
             shape_features: true,
-            position_features: false,
-            clock_features: false,
             robust_passes: 1,
             robust_floor: 1.0,
             mirror: false,
@@ -104,8 +89,6 @@ impl AlignedGbmParams {
             lags: self.lags,
             window: self.window,
             shape: self.shape_features,
-            position: self.position_features,
-            clock: self.clock_features,
         }
     }
 
@@ -126,12 +109,6 @@ impl AlignedGbmParams {
         at_least_one("horizons", self.horizons)?;
         at_least_one("iterations", self.iterations)?;
         at_least_one("max_samples", self.max_samples)?;
-        if self.mirror && self.position_features {
-            return Err(invalid(
-                "mirror",
-                "cannot be used with position_features (a place has no mirror image)",
-            ));
-        }
         if self.window < 2 {
             return Err(invalid(
                 "window",

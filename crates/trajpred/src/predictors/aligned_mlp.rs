@@ -28,19 +28,6 @@ pub struct AlignedMlpParams {
     /// Also describe the window's shape, as
     /// [`AlignedGbmParams::shape_features`](super::AlignedGbmParams::shape_features).
     pub shape_features: bool,
-    /// Also describe where the window ends and where it heads in the data's own axes (the
-    /// last point and the unit heading), so that the model can learn where targets go from
-    /// a place: only meaningful when every track shares one frame (`evaluate --origin`),
-    /// and the only features that are not the same for a turned or moved history.
-    /// Default `false`.
-    #[serde(default)]
-    pub position_features: bool,
-    /// Also describe when the window ends: the phase of the origin's time in the day and
-    /// in the week (times read as seconds since 1970-01-01 UTC, as the loaders give them),
-    /// so that the model can learn how targets move at night or at rush hour. Default
-    /// `false`.
-    #[serde(default)]
-    pub clock_features: bool,
     /// At most this many training origins (an even stride through them when there are
     /// more), which bounds the time a fit takes.
     pub max_samples: usize,
@@ -63,8 +50,6 @@ impl Default for AlignedMlpParams {
             window: 20,
             horizons: 6,
             shape_features: true,
-            position_features: false,
-            clock_features: false,
             max_samples: 400_000,
             network: DistanceMlpConfig::default(),
             members: 4,
@@ -78,8 +63,6 @@ impl AlignedMlpParams {
             lags: self.lags,
             window: self.window,
             shape: self.shape_features,
-            position: self.position_features,
-            clock: self.clock_features,
         }
     }
 
