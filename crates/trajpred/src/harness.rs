@@ -391,15 +391,22 @@ pub enum Split {
         /// Seed of the shuffle.
         seed: u64,
     },
+    /// No split: every segment is on both sides (exact repeats left out of each), and the
+    /// caller takes one of them. Fitting on the whole of one dataset and testing on the
+    /// whole of another (`trajpred fit --split none` here, `evaluate --split none --params`
+    /// there) is how a model chosen on our users meets yours; evaluating with fitting on
+    /// such a split would test on the training data, so [`crate::protocol::run`] refuses it.
+    None,
 }
 
 impl Split {
-    /// The split's name as the CLI spells it (`by-time`, `by-track`, `by-user`).
+    /// The split's name as the CLI spells it (`by-time`, `by-track`, `by-user`, `none`).
     pub fn label(&self) -> &'static str {
         match self {
             Split::ByTime { .. } => "by-time",
             Split::ByTrajectory { .. } => "by-track",
             Split::ByGroup { .. } => "by-user",
+            Split::None => "none",
         }
     }
 }
@@ -449,6 +456,17 @@ pub fn split_segments_counted(
     segments: &[Segment],
     how: Split,
 ) -> Result<(Vec<Segment>, Vec<Segment>, Repeats)> {
+    if how == Split::None {
+        // each side on its own: the test side is not compared with the training side
+        let (train, _, r_train) = drop_repeats(segments.to_vec(), Vec::new());
+        let (_, test, r_test) = drop_repeats(Vec::new(), segments.to_vec());
+        let r = Repeats {
+            train: r_train.train,
+            test_of_train: 0,
+            test: r_test.test,
+        };
+        return Ok((train, test, r));
+    }
     let (train, test) = split_sides(segments, how)?;
     Ok(drop_repeats(train, test))
 }
@@ -473,20 +491,40 @@ impl Repeats {
     }
 }
 
-fn segment_key(s: &Segment) -> u64 {
-    use std::hash::{Hash, Hasher};
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    format!("{:?}", s.frame).hash(&mut h);
-    s.trajectory.len().hash(&mut h);
+/// A fingerprint of a segment's frame, timestamps and points (not its group or id): equal
+/// for exact repeats, stable across runs, machines and builds (64-bit FNV-1a over the bits
+/// of every number, little-endian), so that saved parameters can list the segments they
+/// were fitted on and a later evaluation can leave them out of its test part
+/// ([`crate::params::FittedOn::train_fingerprints`]).
+pub fn segment_fingerprint(s: &Segment) -> u64 {
+    const PRIME: u64 = 0x0000_0100_0000_01b3;
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |x: u64| {
+        for b in x.to_le_bytes() {
+            h = (h ^ u64::from(b)).wrapping_mul(PRIME);
+        }
+    };
+    match s.frame {
+        trajpred_data::Frame::Geodetic => eat(1),
+        trajpred_data::Frame::Cartesian => eat(2),
+        trajpred_data::Frame::Enu(o) => {
+            eat(3);
+            for v in [o.lat_deg, o.lon_deg, o.alt_m] {
+                eat(v.to_bits());
+            }
+        }
+    }
+    eat(s.trajectory.len() as u64);
+    eat(s.trajectory.dim() as u64);
     for t in s.trajectory.times() {
-        t.to_bits().hash(&mut h);
+        eat(t.to_bits());
     }
     for axis in s.trajectory.axes() {
         for v in axis {
-            v.to_bits().hash(&mut h);
+            eat(v.to_bits());
         }
     }
-    h.finish()
+    h
 }
 
 /// Leaves out every segment that repeats another exactly (the same frame, timestamps and
@@ -527,7 +565,7 @@ pub fn drop_repeats(
     let mut r = Repeats::default();
     let mut kept_train: Vec<Segment> = Vec::with_capacity(train.len());
     for s in train {
-        let list = index.entry(segment_key(&s)).or_default();
+        let list = index.entry(segment_fingerprint(&s)).or_default();
         if list.iter().any(|&(_, i)| same(&kept_train[i], &s)) {
             r.train += 1;
         } else {
@@ -537,7 +575,7 @@ pub fn drop_repeats(
     }
     let mut kept_test: Vec<Segment> = Vec::with_capacity(test.len());
     for s in test {
-        let list = index.entry(segment_key(&s)).or_default();
+        let list = index.entry(segment_fingerprint(&s)).or_default();
         let hit = list.iter().find(|&&(in_train, i)| {
             same(
                 if in_train {
@@ -564,6 +602,8 @@ fn split_sides(segments: &[Segment], how: Split) -> Result<(Vec<Segment>, Vec<Se
     use rand::SeedableRng;
     use rand::seq::SliceRandom;
     match how {
+        // (split_segments_counted takes this one apart itself)
+        Split::None => Ok((segments.to_vec(), segments.to_vec())),
         Split::ByTime { train_fraction } => {
             check_fraction(train_fraction)?;
             let (mut train, mut test) = (Vec::new(), Vec::new());

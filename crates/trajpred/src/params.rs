@@ -9,7 +9,7 @@
 //!   "version": 1,
 //!   "fitted_on": { protocol, dataset, path, segmentation, split, seed, max_units,
 //!                  max_train, segments, train_segments, train_points,
-//!                  repeated_train_segments },
+//!                  repeated_train_segments, train_fingerprints },
 //!   "methods": [ { label, name, options, summary, fit_seconds, params }, ... ]
 //! }
 //! ```
@@ -227,6 +227,33 @@ pub struct FittedOn {
     /// ([`harness::drop_repeats`]; 0 in files written before it).
     #[serde(default)]
     pub repeated_train_segments: usize,
+    /// The training segments' fingerprints ([`harness::segment_fingerprint`], saved as 16
+    /// hex digits each): `evaluate --params` leaves out of its test part every segment
+    /// found here, even in another dataset or folder, because the saved methods have seen
+    /// it. Empty in files written before it (nothing is then left out).
+    #[serde(default, with = "hex_fingerprints")]
+    pub train_fingerprints: Vec<u64>,
+}
+
+/// [`FittedOn::train_fingerprints`] as hex strings (exact in every JSON reader, unlike
+/// numbers above 2^53).
+mod hex_fingerprints {
+    use serde::{Deserialize, Deserializer, Serializer, de::Error};
+
+    pub(super) fn serialize<S: Serializer>(v: &[u64], s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(v.iter().map(|x| format!("{x:016x}")))
+    }
+
+    pub(super) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<u64>, D::Error> {
+        Vec::<String>::deserialize(d)?
+            .iter()
+            .map(|h| {
+                u64::from_str_radix(h, 16).map_err(|e| {
+                    D::Error::custom(format!("a training fingerprint `{h}` is not hex: {e}"))
+                })
+            })
+            .collect()
+    }
 }
 
 /// One method's saved parameters.
@@ -354,7 +381,7 @@ pub fn fit(
         });
     }
     let seed = match protocol.split {
-        Split::ByTime { .. } => None,
+        Split::ByTime { .. } | Split::None => None,
         Split::ByTrajectory { seed, .. } | Split::ByGroup { seed, .. } => Some(seed),
     };
     Ok(ParamsFile {
@@ -373,6 +400,7 @@ pub fn fit(
             train_segments: train.len(),
             train_points: train_tr.iter().map(Trajectory::len).sum(),
             repeated_train_segments: repeats.train,
+            train_fingerprints: train.iter().map(harness::segment_fingerprint).collect(),
         },
         methods,
         source: unsaved(),
@@ -598,6 +626,22 @@ impl ParamsFile {
             format!("{:?}", protocol.max_train),
         );
         out
+    }
+
+    /// Leaves out of `test` every segment the saved methods were fitted on
+    /// ([`FittedOn::train_fingerprints`]; a fingerprint match, not compared point by
+    /// point, since the training data are not at hand), returning the rest and how many
+    /// were left out.
+    pub fn drop_seen(&self, test: Vec<Segment>) -> (Vec<Segment>, usize) {
+        let seen: std::collections::HashSet<u64> =
+            self.fitted_on.train_fingerprints.iter().copied().collect();
+        let before = test.len();
+        let kept: Vec<Segment> = test
+            .into_iter()
+            .filter(|s| !seen.contains(&harness::segment_fingerprint(s)))
+            .collect();
+        let dropped = before - kept.len();
+        (kept, dropped)
     }
 
     /// The file it was read from, or `<unsaved>`.

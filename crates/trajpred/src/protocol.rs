@@ -304,6 +304,7 @@ impl Protocol {
                 train_fraction,
                 seed,
             } => (train_fraction, Some(seed)),
+            Split::None => (1.0, None),
         };
         let _ = writeln!(
             s,
@@ -427,6 +428,15 @@ pub fn run(
     segments: &[Segment],
     progress: &dyn Progress,
 ) -> Result<ProtocolRun> {
+    if protocol.split == Split::None {
+        return Err(Error::InvalidParameter {
+            name: "split",
+            reason: "`none` puts every segment on both sides: fitting and testing on it would \
+                     test the methods on their training data (fit on other data and evaluate \
+                     with the saved parameters instead)"
+                .into(),
+        });
+    }
     run_with(protocol, segments, progress, &build_and_fit)
 }
 
@@ -449,10 +459,12 @@ pub fn run_with(
     )
 }
 
-/// [`run_with`] on a split already made: makes each method's predictor with `fitter` from
-/// `train` and its groups and evaluates on `test`. `segments` (how many there were before
-/// the split) only words the error for an empty test part.
-fn run_split(
+/// [`run_with`] on a split already made (by [`split_counted`], then perhaps trimmed, as
+/// `evaluate --params` trims the segments its parameters were fitted on): makes each
+/// method's predictor with `fitter` from `train` and its groups and evaluates on `test`.
+/// `segments` (how many there were before the split) only words the error for an empty
+/// test part.
+pub fn run_split(
     protocol: &Protocol,
     segments: usize,
     (train, test, repeats): (Vec<Segment>, Vec<Segment>, harness::Repeats),

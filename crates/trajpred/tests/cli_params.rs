@@ -23,8 +23,13 @@ fn ok(out: Output) -> String {
 /// One CSV of eight tracks (`track` column), 80 points each at 1 s, every track its own
 /// curve.
 fn write_tracks(dir: &Path) -> PathBuf {
+    write_tracks_of(dir, "tracks.csv", 0..8)
+}
+
+/// Tracks `ks` of the family of [`write_tracks`] in the CSV `name`.
+fn write_tracks_of(dir: &Path, name: &str, ks: std::ops::Range<i32>) -> PathBuf {
     let mut s = String::from("track,t,x,y\n");
-    for k in 0..8 {
+    for k in ks {
         let f = f64::from(k);
         for i in 0..80 {
             let t = f64::from(i);
@@ -33,7 +38,7 @@ fn write_tracks(dir: &Path) -> PathBuf {
             s.push_str(&format!("v{k},{t},{x},{y}\n"));
         }
     }
-    let p = dir.join("tracks.csv");
+    let p = dir.join(name);
     std::fs::write(&p, s).expect("write");
     p
 }
@@ -187,4 +192,100 @@ fn fit_and_params_errors_are_one_clear_line() {
     }
     // nothing was written by the refused fit
     assert!(!out_file.exists());
+}
+
+/// The `trajectories` column of a CSV table's rows.
+fn tested(table: &str) -> Vec<String> {
+    let mut lines = table.lines();
+    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let col = header
+        .iter()
+        .position(|c| *c == "trajectories")
+        .expect("a trajectories column");
+    lines
+        .map(|l| l.split(',').nth(col).expect("cell").to_string())
+        .collect()
+}
+
+#[test]
+fn fit_on_one_dataset_and_evaluate_on_every_segment_of_another() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // ours: tracks 0-7; yours: tracks 6-13, of which 6 and 7 are copies of ours
+    let ours = write_tracks_of(dir.path(), "ours.csv", 0..8);
+    let yours = write_tracks_of(dir.path(), "yours.csv", 6..14);
+    let (ours, yours) = (
+        ours.to_str().expect("utf-8"),
+        yours.to_str().expect("utf-8"),
+    );
+    let params = dir.path().join("params.json");
+    let params_s = params.to_str().expect("utf-8");
+    let args = |cmd: &str, data: &str| -> Vec<String> {
+        [
+            cmd,
+            "--dataset",
+            "csv",
+            "--path",
+            data,
+            "--methods",
+            "kf-cv,hmm",
+            "--history",
+            "10",
+            "--horizon",
+            "3",
+            "--split",
+            "none",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+    };
+    let run = |a: &[String]| trajpred(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    // fit on every segment of ours
+    let mut fit = args("fit", ours);
+    fit.extend(["--output".into(), params_s.into()]);
+    let summary = ok(run(&fit));
+    assert!(summary.contains("(8 training segments"), "{summary}");
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&params).expect("written")).expect("JSON");
+    assert_eq!(v["fitted_on"]["split"], "None");
+    assert_eq!(
+        v["fitted_on"]["train_fingerprints"]
+            .as_array()
+            .map(Vec::len),
+        Some(8)
+    );
+
+    // every segment of yours is tested but the two copies of ours the methods have seen
+    let mut eval = args("evaluate", yours);
+    eval.extend([
+        "--params".into(),
+        params_s.into(),
+        "--format".into(),
+        "csv".into(),
+    ]);
+    let out = run(&eval);
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(err.contains("left out 2 test segments that"), "{err}");
+    let table = ok(out);
+    assert_eq!(tested(&table), ["6", "6"], "{table}");
+
+    // without saved parameters nothing may be fitted on a test part: refused
+    let out = run(&args("evaluate", yours));
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("`none` puts every segment on both sides"),
+        "{err}"
+    );
+
+    // on ours itself every segment was seen in fitting: nothing is left to test
+    let mut same = args("evaluate", ours);
+    same.extend(["--params".into(), params_s.into()]);
+    let out = run(&same);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("too few for a test part (8 test segments left out"),
+        "{err}"
+    );
 }

@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use trajpred::dataset::{Dataset, Segment, Segmentation, load};
-use trajpred::harness::{Split, split_segments, split_segments_counted};
+use trajpred::harness::{Split, segment_fingerprint, split_segments, split_segments_counted};
 use trajpred_core::{Error, Trajectory};
 
 fn run(args: &[&str]) -> Output {
@@ -180,6 +180,54 @@ fn split_by_user_keeps_every_user_on_one_side() {
         }
         other => panic!("expected InvalidParameter split, got {other:?}"),
     }
+}
+
+#[test]
+fn no_split_puts_every_segment_on_both_sides_once_and_fingerprints_are_stable() {
+    let seg = |g: &str, x0: f64| Segment {
+        group: g.into(),
+        id: g.into(),
+        frame: trajpred_data::Frame::Cartesian,
+        trajectory: Trajectory::new(vec![0.0, 1.0], vec![[x0, 0.0], [x0 + 1.0, 0.0]])
+            .expect("track"),
+    };
+    // b repeats a exactly: each side keeps one copy, and no side is compared with the other
+    let segments = vec![seg("a", 0.0), seg("b", 0.0), seg("c", 5.0)];
+    let (train, test, r) = split_segments_counted(&segments, Split::None).expect("split");
+    let groups = |v: &[Segment]| v.iter().map(|s| s.group.clone()).collect::<Vec<_>>();
+    assert_eq!(groups(&train), ["a", "c"]);
+    assert_eq!(groups(&test), ["a", "c"]);
+    assert_eq!((r.train, r.test_of_train, r.test), (1, 0, 1));
+    // evaluating with fitting on it would test on the training data: refused
+    let p = trajpred::protocol::preset("kf-dynamic-geolife", 0, true).expect("preset");
+    let p = trajpred::protocol::Protocol {
+        split: Split::None,
+        ..p
+    };
+    match trajpred::protocol::run(&p, &segments, &trajpred::protocol::Silent) {
+        Err(Error::InvalidParameter { name, reason }) => {
+            assert_eq!(name, "split");
+            assert!(reason.contains("both sides"), "{reason}");
+        }
+        other => panic!(
+            "expected InvalidParameter split, got {:?}",
+            other.map(|r| r.labels)
+        ),
+    }
+    // 64-bit FNV-1a over the little-endian bits (frame tag and origin, length, axes, times,
+    // then each axis), computed independently in Python:
+    // struct.pack('<Q', w) per word, h = ((h ^ byte) * 0x100000001b3) mod 2^64
+    assert_eq!(segment_fingerprint(&segments[0]), 0xbdf4_49d3_7d43_f007);
+    let enu = Segment {
+        group: "d".into(),
+        id: "d".into(),
+        frame: trajpred_data::Frame::Enu(
+            trajpred_data::geodesy::Geodetic::new(39.9, 116.4, 0.0).expect("origin"),
+        ),
+        trajectory: Trajectory::new(vec![10.0, 11.5], vec![[3.0, -1.0], [4.0, -2.0]])
+            .expect("track"),
+    };
+    assert_eq!(segment_fingerprint(&enu), 0x8279_f3fe_d374_9881);
 }
 
 #[test]

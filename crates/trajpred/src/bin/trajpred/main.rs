@@ -3,18 +3,20 @@
 // a command-line tool writes its results to standard output
 #![allow(clippy::print_stdout)]
 
+mod args;
 mod custom;
 mod folds;
 mod output;
 mod progress;
 
 use anyhow::{Context, Result, bail};
-use clap::{Parser, Subcommand, ValueEnum};
+use args::{LimitArgs, SegmentArgs, SplitArg};
+use clap::{Parser, Subcommand};
 use custom::{custom_options, custom_protocol, load_segments};
 use output::{Format, table, write_atomic, write_forecast};
 use progress::Bars;
 use std::path::PathBuf;
-use trajpred::dataset::{self, Dataset, Loaded, Segment, Segmentation};
+use trajpred::dataset::{self, Dataset, Loaded, Segment};
 use trajpred::harness::{EvalConfig, MethodReport, Split};
 use trajpred::params::{self, ParamsFile};
 use trajpred::plot::{Chart, Series, write_chart};
@@ -22,7 +24,6 @@ use trajpred::protocol::{self, Protocol};
 use trajpred::registry::{MethodOptions, all_methods, build, leaderboard_methods};
 use trajpred_core::MAX_HORIZON;
 use trajpred_core::{Forecast, Trajectory};
-use trajpred_data::LoadOptions;
 
 /// The neural methods allocate and free a tensor per operation (burn's ops return new
 /// tensors): mimalloc serves that churn with less work than glibc's malloc (the
@@ -39,68 +40,6 @@ static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 struct Cli {
     #[command(subcommand)]
     command: Command,
-}
-
-/// Segmentation options, applied right after loading (before anything else).
-#[derive(clap::Args, Clone)]
-struct SegmentArgs {
-    /// Split a track where two fixes are more than this many seconds apart.
-    #[arg(long)]
-    max_gap: Option<f64>,
-    /// Keep segments with at least this many points (default: what the command needs).
-    #[arg(long)]
-    min_points: Option<usize>,
-    /// Resample every segment to this step (seconds), inside the segment only.
-    #[arg(long)]
-    resample: Option<f64>,
-    /// Refuse a resampling that would create more points than this.
-    #[arg(long, default_value_t = dataset::DEFAULT_MAX_RESAMPLED_POINTS)]
-    max_resampled_points: usize,
-}
-
-impl SegmentArgs {
-    fn segmentation(&self, needed: usize) -> Segmentation {
-        Segmentation {
-            max_gap: self.max_gap,
-            min_points: self.min_points.unwrap_or(needed).max(1),
-            resample: self.resample,
-            max_resampled_points: self.max_resampled_points,
-        }
-    }
-}
-
-/// Limits on what the loaders read (each has a default; a crossed limit is an error naming
-/// the file, the line and the option to raise).
-#[derive(clap::Args, Clone)]
-struct LimitArgs {
-    /// Longest line read, bytes.
-    #[arg(long, default_value_t = trajpred_data::MAX_LINE_BYTES)]
-    max_line_bytes: usize,
-    /// Most decompressed bytes read from one text file.
-    #[arg(long, default_value_t = trajpred_data::MAX_FILE_BYTES)]
-    max_file_bytes: u64,
-    /// Most decompressed bytes read from one JSON file (read whole).
-    #[arg(long, default_value_t = trajpred_data::MAX_JSON_BYTES)]
-    max_json_bytes: u64,
-    /// Most points in one track.
-    #[arg(long, default_value_t = trajpred_data::MAX_TRACK_POINTS)]
-    max_track_points: usize,
-    /// Most points loaded in all.
-    #[arg(long, default_value_t = trajpred_data::MAX_TOTAL_POINTS)]
-    max_total_points: usize,
-}
-
-impl LimitArgs {
-    fn apply(&self, opts: LoadOptions) -> LoadOptions {
-        LoadOptions {
-            max_line_bytes: self.max_line_bytes,
-            max_file_bytes: self.max_file_bytes,
-            max_json_bytes: self.max_json_bytes,
-            max_track_points: self.max_track_points,
-            max_total_points: self.max_total_points,
-            ..opts
-        }
-    }
 }
 
 /// A horizon within the stated limit, checked before any model is sized by it.
@@ -126,14 +65,6 @@ struct Input {
     segment: SegmentArgs,
     #[command(flatten)]
     limits: LimitArgs,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum SplitArg {
-    /// Segments are shuffled and split (segments of one trip may fall on both sides).
-    ByTrack,
-    /// Users (vehicles, files) are shuffled and split: no user on both sides.
-    ByUser,
 }
 
 #[derive(Subcommand)]
@@ -387,21 +318,6 @@ fn last_points(tr: &Trajectory, history: Option<usize>) -> Result<Trajectory> {
     }
 }
 
-impl SplitArg {
-    fn of(self, train_fraction: f64, seed: u64) -> Split {
-        match self {
-            SplitArg::ByTrack => Split::ByTrajectory {
-                train_fraction,
-                seed,
-            },
-            SplitArg::ByUser => Split::ByGroup {
-                train_fraction,
-                seed,
-            },
-        }
-    }
-}
-
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Methods => {
@@ -583,10 +499,23 @@ fn run(cli: Cli) -> Result<()> {
                 return Ok(());
             }
             let run = match &saved {
-                Some(file) => protocol::run_with(&p, &loaded.segments, &bars, &|m, _, _| {
-                    file.predictor(&m.label)
-                        .map_err(|e| trajpred_core::Error::method(m.label.clone(), e))
-                })?,
+                Some(file) => {
+                    let (train, test, mut repeats) = protocol::split_counted(&p, &loaded.segments)?;
+                    // the saved methods have seen these, whatever data they came from
+                    let (test, seen) = file.drop_seen(test);
+                    if seen > 0 {
+                        eprintln!(
+                            "note: left out {seen} test segments that {} was fitted on",
+                            file.source()
+                        );
+                    }
+                    repeats.test_of_train += seen;
+                    let made = (train, test, repeats);
+                    protocol::run_split(&p, loaded.segments.len(), made, &bars, &|m, _, _| {
+                        file.predictor(&m.label)
+                            .map_err(|e| trajpred_core::Error::method(m.label.clone(), e))
+                    })?
+                }
                 None => protocol::run(&p, &loaded.segments, &bars)?,
             };
             say_fitted(&run);
