@@ -510,6 +510,10 @@ fn run(cli: Cli) -> Result<()> {
                         );
                     }
                     repeats.test_of_train += seen;
+                    if p.split == Split::None {
+                        // (the training side is these data, which train nothing here)
+                        repeats.train = 0;
+                    }
                     let made = (train, test, repeats);
                     protocol::run_split(&p, loaded.segments.len(), made, &bars, &|m, _, _| {
                         file.predictor(&m.label)
@@ -525,14 +529,26 @@ fn run(cli: Cli) -> Result<()> {
                 folds::figure(&s, &title, path)?;
                 eprintln!("wrote {}", path.display());
             }
-            eprintln!(
-                "{}: {} training and {} test segments ({} split){}",
-                p.name,
-                run.train.len(),
-                run.test.len(),
-                p.split.label(),
-                repeats_note(&run.repeats)
-            );
+            match (&saved, p.split) {
+                // nothing of these data trained: say what did
+                (Some(file), Split::None) => eprintln!(
+                    "{}: {} test segments (none split: every segment tests; fitted on {} \
+                     training segments of {}){}",
+                    p.name,
+                    run.test.len(),
+                    file.fitted_on.train_segments,
+                    file.fitted_on.path,
+                    repeats_note(&run.repeats)
+                ),
+                _ => eprintln!(
+                    "{}: {} training and {} test segments ({} split){}",
+                    p.name,
+                    run.train.len(),
+                    run.test.len(),
+                    p.split.label(),
+                    repeats_note(&run.repeats)
+                ),
+            }
             if p.histories.len() == 1 {
                 let reports: Vec<MethodReport> = run
                     .reports
