@@ -409,6 +409,24 @@ impl Split {
             Split::None => "none",
         }
     }
+
+    /// The share that trains (`None` for [`Split::None`]).
+    pub fn train_fraction(&self) -> Option<f64> {
+        match *self {
+            Split::ByTime { train_fraction }
+            | Split::ByTrajectory { train_fraction, .. }
+            | Split::ByGroup { train_fraction, .. } => Some(train_fraction),
+            Split::None => None,
+        }
+    }
+
+    /// The shuffle's seed (`None` for the splits that do not shuffle).
+    pub fn seed(&self) -> Option<u64> {
+        match *self {
+            Split::ByTrajectory { seed, .. } | Split::ByGroup { seed, .. } => Some(seed),
+            Split::ByTime { .. } | Split::None => None,
+        }
+    }
 }
 
 fn check_fraction(f: f64) -> Result<()> {

@@ -380,10 +380,7 @@ pub fn fit(
             params: p.fitted_params().map_err(fail)?,
         });
     }
-    let seed = match protocol.split {
-        Split::ByTime { .. } | Split::None => None,
-        Split::ByTrajectory { seed, .. } | Split::ByGroup { seed, .. } => Some(seed),
-    };
+    let seed = protocol.split.seed();
     Ok(ParamsFile {
         format: FORMAT.into(),
         version: VERSION,

@@ -294,22 +294,12 @@ impl Protocol {
                 .resample
                 .map_or(String::new(), |dt| format!(", resampled every {dt} s")),
         );
-        let (fraction, seed) = match self.split {
-            Split::ByTime { train_fraction } => (train_fraction, None),
-            Split::ByTrajectory {
-                train_fraction,
-                seed,
-            }
-            | Split::ByGroup {
-                train_fraction,
-                seed,
-            } => (train_fraction, Some(seed)),
-            Split::None => (1.0, None),
-        };
+        let (fraction, seed) = (self.split.train_fraction(), self.split.seed());
         let _ = writeln!(
             s,
-            "  split: {}, training share {fraction}{}, at most {} training and {} test segments",
+            "  split: {}{}{}, at most {} training and {} test segments",
             self.split.label(),
+            fraction.map_or(String::new(), |f| format!(", training share {f}")),
             seed.map_or(String::new(), |x| format!(", seed {x}")),
             opt(self.max_train),
             opt(self.max_test),

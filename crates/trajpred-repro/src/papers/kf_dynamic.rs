@@ -25,7 +25,6 @@ use crate::{Context, Paper, ReproError, Result};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use trajpred::dataset::{self, Segment, Segmentation};
-use trajpred::harness::Split;
 use trajpred::protocol::{self, Protocol};
 use trajpred_data::LoadReport;
 
@@ -219,11 +218,8 @@ fn data_lines(ds: Ds, p: &Params, d: &Loaded) -> Vec<String> {
 /// The template variables of a dataset's protocol (its notes and setup lines).
 fn protocol_vars(ds: Ds, p: &Protocol, out: &mut Computed) {
     let d = ds.key();
-    let fraction = match p.split {
-        Split::ByTime { train_fraction }
-        | Split::ByTrajectory { train_fraction, .. }
-        | Split::ByGroup { train_fraction, .. } => train_fraction,
-    };
+    // (the presets always split; `none` would say 0)
+    let fraction = p.split.train_fraction().unwrap_or(0.0);
     out.var(&format!("{d}.protocol"), p.name.as_str());
     out.var(&format!("{d}.max_units"), p.max_units.unwrap_or(0));
     out.var(&format!("{d}.max_test"), p.max_test.unwrap_or(0));

@@ -6,7 +6,7 @@ use crate::{Context, ReproError, Result};
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
 use trajpred::Trajectory;
-use trajpred::harness::{self, EvalConfig, MethodReport, Split};
+use trajpred::harness::{self, EvalConfig, MethodReport};
 use trajpred::predictors::{KfDynamic, KfDynamicParams, NaiveKf};
 use trajpred::protocol::{self, Protocol, ProtocolRun};
 
@@ -68,10 +68,7 @@ pub(super) fn run_grid(
     let hmm_fit_seconds = run.fit_seconds[hmm];
     let hmm_states = run.predictors[hmm].fitted_summary();
     // run time against the number of test trajectories: seeded random samples of the pool
-    let seed = match p.split {
-        Split::ByTrajectory { seed, .. } | Split::ByGroup { seed, .. } => seed,
-        Split::ByTime { .. } => ctx.seed,
-    };
+    let seed = p.split.seed().unwrap_or(ctx.seed);
     let timing_test = p
         .test_at(&run.test, params.timing_history)
         .map_err(experiment_err("trim"))?;
