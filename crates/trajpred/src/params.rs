@@ -69,8 +69,10 @@ use trajpred_core::{Error, Predictor, Trajectory};
 pub const FORMAT: &str = "trajpred-params";
 /// The format version this build writes and reads.
 pub const VERSION: u64 = 1;
-/// Largest parameter file read, bytes (a GSKF of m = T = 64 over 3 axes is ~0.3 MB).
-pub const MAX_PARAMS_BYTES: u64 = 64 << 20;
+/// Largest parameter file written or read, bytes (a GSKF of m = T = 64 over 3 axes is
+/// ~0.3 MB; on GeoLife, `aligned-gbm` and `aligned-mlp` ~35 MB, `auto` and `blend` ~56 MB,
+/// the learners saved again inside them).
+pub const MAX_PARAMS_BYTES: u64 = 256 << 20;
 /// Most methods in one file.
 pub const MAX_METHODS: usize = 64;
 /// Largest window m and number of horizons T of a loaded GSC/GSKF (the papers use m <= 8,
@@ -414,13 +416,12 @@ impl ParamsFile {
     }
 
     /// Writes the file whole or not at all ([`trajpred_core::io::write_atomic`]).
+    /// A file over [`MAX_PARAMS_BYTES`] is refused ([`ParamsError::TooLarge`]) and nothing
+    /// is written: [`ParamsFile::load`] would refuse it.
     pub fn save(&self, path: &Path) -> Result<(), ParamsError> {
         let mut bytes = self.to_json()?;
         bytes.push(b'\n');
-        trajpred_core::io::write_atomic(path, &bytes).map_err(|error| ParamsError::Io {
-            file: path.display().to_string(),
-            error,
-        })
+        write_within(path, &bytes, MAX_PARAMS_BYTES)
     }
 
     /// Reads and checks the file at `path` (at most [`MAX_PARAMS_BYTES`]).
@@ -644,5 +645,38 @@ impl ParamsFile {
     /// The file it was read from, or `<unsaved>`.
     pub fn source(&self) -> &str {
         &self.source
+    }
+}
+
+/// Writes `bytes` to `path` whole, unless they are more than `limit`.
+fn write_within(path: &Path, bytes: &[u8], limit: u64) -> Result<(), ParamsError> {
+    let file = || path.display().to_string();
+    if bytes.len() as u64 > limit {
+        return Err(ParamsError::TooLarge {
+            file: file(),
+            limit,
+        });
+    }
+    trajpred_core::io::write_atomic(path, bytes).map_err(|error| ParamsError::Io {
+        file: file(),
+        error,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{ParamsError, write_within};
+
+    #[test]
+    fn a_file_over_the_limit_is_refused_and_not_written() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("p.json");
+        assert!(matches!(
+            write_within(&path, &[b' '; 11], 10),
+            Err(ParamsError::TooLarge { limit: 10, .. })
+        ));
+        assert!(!path.exists());
+        write_within(&path, &[b' '; 10], 10).expect("at the limit");
+        assert_eq!(std::fs::read(&path).expect("written").len(), 10);
     }
 }
