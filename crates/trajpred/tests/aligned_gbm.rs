@@ -214,6 +214,18 @@ fn bad_parameters_and_misuse_are_typed_errors() {
         same.forecast(&h, 5).expect("forecast"),
         m.forecast(&h, 5).expect("forecast")
     );
+    // the fitted one counts its training origins; the loaded one says where it came from
+    let said = |p: &AlignedGbm| p.fitted_summary().expect("a summary");
+    assert!(
+        said(&m).contains("training origins per step ["),
+        "{}",
+        said(&m)
+    );
+    assert!(
+        said(&same).contains("; loaded from saved parameters"),
+        "{}",
+        said(&same)
+    );
 }
 
 /// Straight tracks of 10 points at 10 m/s along x on a 1 s grid (one origin with 8 legs

@@ -74,6 +74,14 @@ fn saved_networks_load_back_and_damaged_ones_are_typed_errors_naming_the_path() 
         m.forecast(&hist, 3).unwrap(),
         loaded.forecast(&hist, 3).unwrap()
     );
+    // the fitted one counts its training origins; the loaded one says where it came from
+    assert!(m.fitted_summary().unwrap().contains(" training origins"));
+    assert!(
+        loaded
+            .fitted_summary()
+            .unwrap()
+            .contains("; loaded from saved parameters")
+    );
 
     let mut short = saved.clone();
     short["networks"][1]["layers"][0]["weights"]

@@ -498,10 +498,15 @@ impl Predictor for AlignedGbm {
             .iter()
             .map(|[a, b]| format!("{}+{}", a.trees(), b.trees()))
             .collect();
+        // (loaded parameters do not say how many origins trained them)
+        let origins = if self.samples.is_empty() {
+            "loaded from saved parameters".to_string()
+        } else {
+            format!("training origins per step {:?}", self.samples)
+        };
         Some(format!(
-            "trees per step (along+across) {}; training origins per step {:?}{}",
+            "trees per step (along+across) {}; {origins}{}",
             trees.join(", "),
-            self.samples,
             base_said(self.base, self.base_errors)
         ))
     }

@@ -368,12 +368,16 @@ impl Predictor for AlignedMlp {
 
     fn fitted_summary(&self) -> Option<String> {
         let m = self.model.first()?;
+        // (loaded parameters do not say how many origins trained them)
+        let origins = match self.samples {
+            0 => "loaded from saved parameters".to_string(),
+            n => format!("{n} training origins"),
+        };
         Some(format!(
-            "{} network(s) of {} features to {} steps; {} training origins{}",
+            "{} network(s) of {} features to {} steps; {origins}{}",
             self.model.len(),
             m.features(),
             m.pairs(),
-            self.samples,
             base_said(self.base, self.base_errors)
         ))
     }
