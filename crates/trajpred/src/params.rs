@@ -626,6 +626,39 @@ impl ParamsFile {
         out
     }
 
+    /// Evaluates the saved methods as `protocol` says, without fitting: splits `segments`
+    /// ([`protocol::split_counted`]), leaves out of the test part every segment these
+    /// methods were fitted on ([`ParamsFile::drop_seen`], counted with the copies of
+    /// training segments in the run's `repeats`) and evaluates on the rest. With
+    /// [`Split::None`] every segment tests, and the training side's repeats are reported
+    /// as 0 (these data train nothing here). Returns the run and how many test segments
+    /// were left out as seen. What `trajpred evaluate --params` runs.
+    pub fn evaluate(
+        &self,
+        protocol: &Protocol,
+        segments: &[Segment],
+        progress: &dyn Progress,
+    ) -> Result<(protocol::ProtocolRun, usize), Error> {
+        protocol.validate()?;
+        let (train, test, mut repeats) = protocol::split_counted(protocol, segments)?;
+        let (test, seen) = self.drop_seen(test);
+        repeats.test_of_train += seen;
+        if protocol.split == Split::None {
+            repeats.train = 0;
+        }
+        let run = protocol::run_split(
+            protocol,
+            segments.len(),
+            (train, test, repeats),
+            progress,
+            &|m, _, _| {
+                self.predictor(&m.label)
+                    .map_err(|e| Error::method(m.label.clone(), e))
+            },
+        )?;
+        Ok((run, seen))
+    }
+
     /// Leaves out of `test` every segment the saved methods were fitted on
     /// ([`FittedOn::train_fingerprints`]; a fingerprint match, not compared point by
     /// point, since the training data are not at hand), returning the rest and how many

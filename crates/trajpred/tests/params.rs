@@ -629,3 +629,35 @@ fn a_fit_records_the_repeats_it_left_out_and_older_files_without_the_count_load(
     .expect("an older file loads");
     assert_eq!(old.fitted_on.repeated_train_segments, 0);
 }
+
+#[test]
+fn evaluating_saved_parameters_leaves_out_what_they_were_fitted_on_from_any_data() {
+    // fitted on segments 0-5 whole; evaluated on every segment of 4-9, of which 4 and 5
+    // were fitted on
+    let all = segments();
+    let whole = |methods: &[&str]| Protocol {
+        split: Split::None,
+        ..protocol_of(methods)
+    };
+    let p = whole(&["kf-cv", "cv-time"]);
+    let file = params::fit(&p, "ours".as_ref(), &all[..6], &Silent).expect("fit");
+    assert_eq!(file.fitted_on.train_segments, 6);
+    assert_eq!(file.fitted_on.train_fingerprints.len(), 6);
+    let file = reload(&file);
+    let (run, seen) = file.evaluate(&p, &all[4..], &Silent).expect("evaluate");
+    assert_eq!(seen, 2);
+    assert_eq!(run.repeats.test_of_train, 2);
+    let ids: Vec<&str> = run.test.iter().map(|s| s.id.as_str()).collect();
+    let expected: Vec<&str> = all[6..].iter().map(|s| s.id.as_str()).collect();
+    assert_eq!(ids, expected);
+    // fitting on a split of none is refused; evaluating the data it was fitted on leaves
+    // nothing to test
+    assert!(matches!(
+        protocol::run(&p, &all, &Silent),
+        Err(Error::InvalidParameter { name: "split", .. })
+    ));
+    assert!(matches!(
+        file.evaluate(&p, &all[..6], &Silent),
+        Err(Error::InvalidParameter { name: "segments", .. })
+    ));
+}

@@ -500,25 +500,14 @@ fn run(cli: Cli) -> Result<()> {
             }
             let run = match &saved {
                 Some(file) => {
-                    let (train, test, mut repeats) = protocol::split_counted(&p, &loaded.segments)?;
-                    // the saved methods have seen these, whatever data they came from
-                    let (test, seen) = file.drop_seen(test);
+                    let (run, seen) = file.evaluate(&p, &loaded.segments, &bars)?;
                     if seen > 0 {
                         eprintln!(
                             "note: left out {seen} test segments that {} was fitted on",
                             file.source()
                         );
                     }
-                    repeats.test_of_train += seen;
-                    if p.split == Split::None {
-                        // (the training side is these data, which train nothing here)
-                        repeats.train = 0;
-                    }
-                    let made = (train, test, repeats);
-                    protocol::run_split(&p, loaded.segments.len(), made, &bars, &|m, _, _| {
-                        file.predictor(&m.label)
-                            .map_err(|e| trajpred_core::Error::method(m.label.clone(), e))
-                    })?
+                    run
                 }
                 None => protocol::run(&p, &loaded.segments, &bars)?,
             };
