@@ -658,6 +658,9 @@ fn evaluating_saved_parameters_leaves_out_what_they_were_fitted_on_from_any_data
     ));
     assert!(matches!(
         file.evaluate(&p, &all[..6], &Silent),
-        Err(Error::InvalidParameter { name: "segments", .. })
+        Err(Error::InvalidParameter {
+            name: "segments",
+            ..
+        })
     ));
 }
