@@ -93,7 +93,7 @@ pub fn seeds() -> Vec<Vec<u8>> {
             };
             let seg = Segmentation::default();
             let protocol = protocol::custom(Dataset::Csv, names, &options, seg, split, 10, 2);
-            params::fit(&protocol, Path::new("fuzz"), &segments, &Silent)
+            params::fit(&protocol, Path::new("fuzz"), &segments, None, &Silent)
                 .and_then(|f| f.to_json())
                 .unwrap_or_else(|e| panic!("seed file: {e}"))
         })

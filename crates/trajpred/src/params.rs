@@ -7,8 +7,8 @@
 //! {
 //!   "format": "trajpred-params",
 //!   "version": 1,
-//!   "fitted_on": { protocol, dataset, path, segmentation, split, seed, max_units,
-//!                  max_train, segments, train_segments, train_points,
+//!   "fitted_on": { protocol, dataset, path, segmentation, train_segmentation, split, seed,
+//!                  max_units, max_train, segments, train_segments, train_points,
 //!                  repeated_train_segments, train_fingerprints },
 //!   "methods": [ { label, name, options, summary, fit_seconds, params }, ... ]
 //! }
@@ -38,14 +38,14 @@
 //! # let protocol = Protocol {
 //! #     name: "custom".into(), description: String::new(), dataset: Dataset::Csv,
 //! #     load_options: Dataset::Csv.options(), max_units: None,
-//! #     segmentation: Segmentation::default(),
+//! #     segmentation: Segmentation::default(), train_segmentation: None,
 //! #     split: Split::ByTrajectory { train_fraction: 0.5, seed: 1 }, max_train: None,
 //! #     max_test: None, histories: vec![10], horizon: 3, stride: 1, max_origins: None,
 //! #     threshold: 25.0, same_origins: false,
 //! #     methods: vec![MethodSpec { label: "kf-cv".into(), name: "kf-cv".into(),
 //! #                                options: MethodOptions::default() }] };
 //! // fit on the training part of the protocol's split, and save
-//! let file = fit(&protocol, "data/".as_ref(), &segments, &Silent)?;
+//! let file = fit(&protocol, "data/".as_ref(), &segments, None, &Silent)?;
 //! let bytes = file.to_json()?;
 //! // load back (strictly) and forecast without fitting
 //! let loaded = ParamsFile::from_slice(&bytes, "params.json")?;
@@ -211,6 +211,10 @@ pub struct FittedOn {
     pub path: String,
     /// How tracks became segments.
     pub segmentation: Segmentation,
+    /// How the training users' tracks became the segments fitted on, when not as
+    /// `segmentation` ([`Protocol::train_segmentation`]; `None` in files written before it).
+    #[serde(default)]
+    pub train_segmentation: Option<Segmentation>,
     /// How segments were split; the training part was fitted on.
     pub split: Split,
     /// The split's seed (`None` for a split by time).
@@ -232,7 +236,8 @@ pub struct FittedOn {
     /// The training segments' fingerprints ([`harness::segment_fingerprint`], saved as 16
     /// hex digits each): `evaluate --params` leaves out of its test part every segment
     /// found here, even in another dataset or folder, because the saved methods have seen
-    /// it. Empty in files written before it (nothing is then left out).
+    /// it. With a training segmentation, the training users' segments of both cuts are
+    /// here. Empty in files written before it (nothing is then left out).
     #[serde(default, with = "hex_fingerprints")]
     pub train_fingerprints: Vec<u64>,
 }
@@ -346,10 +351,14 @@ pub fn check_exportable(methods: &[MethodSpec]) -> Result<(), ParamsError> {
 /// Fits every method of `protocol` on the training part of its split of `segments` (exactly
 /// the part [`protocol::run`] fits on, so evaluating the loaded file with the same protocol
 /// tests on the held-out part only) and collects what they learned. `data_path` is recorded.
+/// `train_pool`: the tracks cut by the protocol's [training
+/// segmentation](Protocol::train_segmentation) (`None` without one;
+/// [`protocol::split_with_pool`]).
 pub fn fit(
     protocol: &Protocol,
     data_path: &Path,
     segments: &[Segment],
+    train_pool: Option<&[Segment]>,
     progress: &dyn Progress,
 ) -> Result<ParamsFile, ParamsError> {
     let whole = |error| ParamsError::Fit {
@@ -358,7 +367,20 @@ pub fn fit(
     };
     protocol.validate().map_err(whole)?;
     check_exportable(&protocol.methods)?;
-    let (train, _, repeats) = protocol::split_counted(protocol, segments).map_err(whole)?;
+    let (train, _, repeats) =
+        protocol::split_with_pool(protocol, segments, train_pool).map_err(whole)?;
+    // what the saved methods have seen: the training part of both cuts
+    let mut train_fingerprints: Vec<u64> = train.iter().map(harness::segment_fingerprint).collect();
+    if train_pool.is_some() {
+        let plain = Protocol {
+            train_segmentation: None,
+            ..protocol.clone()
+        };
+        let (main_cut, _, _) = protocol::split_counted(&plain, segments).map_err(whole)?;
+        train_fingerprints.extend(main_cut.iter().map(harness::segment_fingerprint));
+        train_fingerprints.sort_unstable();
+        train_fingerprints.dedup();
+    }
     let train_tr: Vec<Trajectory> = train.iter().map(|s| s.trajectory.clone()).collect();
     let groups = harness::group_ids(&train);
     let mut methods = Vec::with_capacity(protocol.methods.len());
@@ -391,6 +413,7 @@ pub fn fit(
             dataset: protocol.dataset,
             path: data_path.display().to_string(),
             segmentation: protocol.segmentation,
+            train_segmentation: protocol.train_segmentation,
             split: protocol.split,
             seed,
             max_units: protocol.max_units,
@@ -399,7 +422,7 @@ pub fn fit(
             train_segments: train.len(),
             train_points: train_tr.iter().map(Trajectory::len).sum(),
             repeated_train_segments: repeats.train,
-            train_fingerprints: train.iter().map(harness::segment_fingerprint).collect(),
+            train_fingerprints,
         },
         methods,
         source: unsaved(),
@@ -489,6 +512,10 @@ impl ParamsFile {
             .segmentation
             .validate()
             .map_err(|e| self.invalid("fitted_on.segmentation", e.to_string()))?;
+        if let Some(t) = &self.fitted_on.train_segmentation {
+            t.validate()
+                .map_err(|e| self.invalid("fitted_on.train_segmentation", e.to_string()))?;
+        }
         let n = self.methods.len();
         if n > MAX_METHODS {
             return Err(ParamsError::Limit {
@@ -640,6 +667,12 @@ impl ParamsFile {
         progress: &dyn Progress,
     ) -> Result<(protocol::ProtocolRun, usize), Error> {
         protocol.validate()?;
+        // nothing is fitted here: how the protocol would cut its training tracks does not
+        // matter, the test part is cut by its segmentation
+        let protocol = &Protocol {
+            train_segmentation: None,
+            ..protocol.clone()
+        };
         let (train, test, mut repeats) = protocol::split_counted(protocol, segments)?;
         let (test, seen) = self.drop_seen(test);
         repeats.test_of_train += seen;

@@ -56,6 +56,11 @@ pub struct Protocol {
     pub max_units: Option<usize>,
     /// How tracks become segments.
     pub segmentation: Segmentation,
+    /// How the training users' tracks become the segments the methods are fitted on, when
+    /// not as [`segmentation`](Self::segmentation) (`None`): e.g. a longer gap gives more
+    /// training origins from the same users ([`split_with_pool`]). The test part is always
+    /// cut by `segmentation`. Only with a split by group or none.
+    pub train_segmentation: Option<Segmentation>,
     /// How segments are split into training and test parts.
     pub split: Split,
     /// Keep at most this many training segments (after the split's shuffle).
@@ -98,6 +103,7 @@ pub fn custom(
         load_options: dataset.options(),
         max_units: None,
         segmentation,
+        train_segmentation: None,
         split,
         max_train: None,
         max_test: None,
@@ -183,6 +189,7 @@ pub fn preset(name: &str, seed: u64, quick: bool) -> Result<Protocol> {
             min_points: max_h + horizon,
             ..Segmentation::default()
         },
+        train_segmentation: None,
         split: Split::ByTrajectory {
             train_fraction: 0.3,
             seed: ds_seed,
@@ -227,6 +234,16 @@ impl Protocol {
     /// Checks the settings; the error names the first bad one.
     pub fn validate(&self) -> Result<()> {
         self.segmentation.validate()?;
+        if let Some(t) = &self.train_segmentation {
+            t.validate()?;
+            if !matches!(self.split, Split::ByGroup { .. } | Split::None) {
+                return Err(Error::InvalidParameter {
+                    name: "train_segmentation",
+                    reason: "a training segmentation needs a split by group (user, vehicle) or                              none: split by track, another cut of a test track could train"
+                        .into(),
+                });
+            }
+        }
         let max_h = self.histories.iter().copied().max().ok_or(Error::Empty {
             what: "protocol histories",
         })?;
@@ -380,12 +397,54 @@ pub fn split(protocol: &Protocol, segments: &[Segment]) -> Result<(Vec<Segment>,
     split_counted(protocol, segments).map(|(train, test, _)| (train, test))
 }
 
-/// [`split`] with the count of the repeated segments left out.
+/// [`split`] with the count of the repeated segments left out. Errors for a protocol with a
+/// [training segmentation](Protocol::train_segmentation): see [`split_with_pool`].
 pub fn split_counted(
     protocol: &Protocol,
     segments: &[Segment],
 ) -> Result<(Vec<Segment>, Vec<Segment>, harness::Repeats)> {
+    split_with_pool(protocol, segments, None)
+}
+
+/// [`split_counted`] for a protocol with a [training
+/// segmentation](Protocol::train_segmentation): `pool` is the tracks cut by it (`None`
+/// without one). The split (and its test part) is made on `segments`, cut by the
+/// protocol's segmentation; the training part is then the segments of `pool` that belong
+/// to the training part's groups (every one of `pool` for [`Split::None`]), exact repeats
+/// left out, [`Protocol::max_train`] applied. Errors when `pool` is given without a
+/// training segmentation or missing with one.
+pub fn split_with_pool(
+    protocol: &Protocol,
+    segments: &[Segment],
+    pool: Option<&[Segment]>,
+) -> Result<(Vec<Segment>, Vec<Segment>, harness::Repeats)> {
     let (mut train, mut test, repeats) = harness::split_segments_counted(segments, protocol.split)?;
+    match (&protocol.train_segmentation, pool) {
+        (None, None) => {}
+        (Some(_), Some(pool)) => {
+            let groups: std::collections::HashSet<&str> =
+                train.iter().map(|s| s.group.as_str()).collect();
+            let mine: Vec<Segment> = pool
+                .iter()
+                .filter(|s| protocol.split == Split::None || groups.contains(s.group.as_str()))
+                .cloned()
+                .collect();
+            train = harness::drop_repeats(mine, Vec::new()).0;
+        }
+        (t, _) => {
+            return Err(Error::InvalidParameter {
+                name: "train_segmentation",
+                reason: if t.is_some() {
+                    "the protocol cuts its training tracks differently: split with the \
+                     segments that cut makes (`split_with_pool`)"
+                } else {
+                    "segments to train on were given for a protocol without a training \
+                     segmentation"
+                }
+                .into(),
+            });
+        }
+    }
     if let Some(n) = protocol.max_train {
         train.truncate(n);
     }
@@ -402,7 +461,7 @@ pub type Fitter<'a> =
 
 /// Builds the method and fits it, telling it the training segments' groups
 /// ([`Predictor::fit_grouped`]): what [`run`] and [`cross_validate`] do.
-pub(crate) fn build_and_fit(
+pub fn build_and_fit(
     m: &MethodSpec,
     train: &[Trajectory],
     groups: &[usize],

@@ -178,6 +178,7 @@ fn custom_protocol(methods: &[&str]) -> Protocol {
             min_points: 13,
             ..Default::default()
         },
+        train_segmentation: None,
         split: Split::ByGroup {
             train_fraction: 0.3,
             seed: 4,

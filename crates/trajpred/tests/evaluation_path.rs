@@ -384,6 +384,50 @@ fn a_csv_folder_of_tracks_evaluates_by_user_without_progress_bars() {
     ]);
     assert_eq!(out.status.code(), Some(1));
     assert!(text(&out.stderr).contains("more than the cap of 1000"));
+    // the training users' tracks cut at a longer gap: their two tracks whole (the pause
+    // kept), the test part as before
+    let with_cut = |split: &str| {
+        run(&[
+            "evaluate",
+            "--dataset",
+            "csv",
+            "--path",
+            dir.to_str().expect("path"),
+            "--methods",
+            "cv-time",
+            "--max-gap",
+            "5",
+            "--train-max-gap",
+            "1000",
+            "--history",
+            "10",
+            "--horizon",
+            "3",
+            "--split",
+            split,
+            "--train-fraction",
+            "0.5",
+            "--format",
+            "csv",
+        ])
+    };
+    let out = with_cut("by-user");
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("more than 1000 s apart: 4 segments of 4 kept (320 points)"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("2 training and 4 test segments"),
+        "{stderr}"
+    );
+    let cells: Vec<&str> = stdout.lines().nth(1).expect("a row").split(',').collect();
+    assert_eq!((cells[1], cells[2]), ("4", "112"), "{stdout}");
+    // split by track, another cut of a test track could train: refused
+    let out = with_cut("by-track");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).contains("train_segmentation"));
 }
 
 #[test]

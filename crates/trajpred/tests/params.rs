@@ -114,7 +114,14 @@ fn bits(f: &Forecast) -> Vec<u64> {
 }
 
 fn fitted_file(methods: &[&str]) -> ParamsFile {
-    params::fit(&protocol_of(methods), "data".as_ref(), &segments(), &Silent).expect("fit")
+    params::fit(
+        &protocol_of(methods),
+        "data".as_ref(),
+        &segments(),
+        None,
+        &Silent,
+    )
+    .expect("fit")
 }
 
 fn reload(file: &ParamsFile) -> ParamsFile {
@@ -614,7 +621,7 @@ fn a_fit_records_the_repeats_it_left_out_and_older_files_without_the_count_load(
     assert_eq!(train.len() + test.len(), 10, "{r:?}");
     assert_eq!(r.total(), 20, "{r:?}");
     assert!(r.train > 0, "{r:?}");
-    let file = params::fit(&p, "data".as_ref(), &segs, &Silent).expect("fit");
+    let file = params::fit(&p, "data".as_ref(), &segs, None, &Silent).expect("fit");
     assert_eq!(file.fitted_on.repeated_train_segments, r.train);
     assert_eq!(file.fitted_on.train_segments, train.len());
     assert_eq!(reload(&file).fitted_on, file.fitted_on);
@@ -640,7 +647,7 @@ fn evaluating_saved_parameters_leaves_out_what_they_were_fitted_on_from_any_data
         ..protocol_of(methods)
     };
     let p = whole(&["kf-cv", "cv-time"]);
-    let file = params::fit(&p, "ours".as_ref(), &all[..6], &Silent).expect("fit");
+    let file = params::fit(&p, "ours".as_ref(), &all[..6], None, &Silent).expect("fit");
     assert_eq!(file.fitted_on.train_segments, 6);
     assert_eq!(file.fitted_on.train_fingerprints.len(), 6);
     let file = reload(&file);

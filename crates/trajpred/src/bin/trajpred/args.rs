@@ -33,6 +33,26 @@ impl SegmentArgs {
     }
 }
 
+/// How the training users' tracks are cut (`evaluate` and `fit`).
+#[derive(clap::Args, Clone, Copy)]
+pub(crate) struct TrainCutArgs {
+    /// Cut the training users' tracks where fixes are more than this many seconds apart
+    /// (default: as `--max-gap`): longer training segments, more origins to learn from. The
+    /// test part is cut by `--max-gap` all the same. Needs `--split by-user` or `none`.
+    #[arg(long)]
+    train_max_gap: Option<f64>,
+}
+
+impl TrainCutArgs {
+    /// The training segmentation: `seg` with the training gap, if one was given.
+    pub(crate) fn of(&self, seg: &Segmentation) -> Option<Segmentation> {
+        self.train_max_gap.map(|g| Segmentation {
+            max_gap: Some(g),
+            ..*seg
+        })
+    }
+}
+
 /// Limits on what the loaders read (each has a default; a crossed limit is an error naming
 /// the file, the line and the option to raise).
 #[derive(clap::Args, Clone)]

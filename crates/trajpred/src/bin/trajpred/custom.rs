@@ -4,7 +4,7 @@
 use super::SegmentArgs;
 use crate::progress::Bars;
 use anyhow::{Context, Result, bail};
-use trajpred::dataset::{self, Dataset, Loaded};
+use trajpred::dataset::{self, Dataset, Loaded, Segment};
 use trajpred::harness::{EvalConfig, Split};
 use trajpred::protocol::{self, Protocol};
 use trajpred::registry::MethodOptions;
@@ -44,19 +44,46 @@ pub(crate) fn custom_protocol(
     }
 }
 
-/// Loads and segments the protocol's data (at least two segments), telling what was read.
-pub(crate) fn load_segments(p: &Protocol, path: &std::path::Path, bars: &Bars) -> Result<Loaded> {
+/// Loads and segments the protocol's data (at least two segments), telling what was read;
+/// with a training segmentation, also the tracks cut by it (the training side's pool,
+/// [`protocol::split_with_pool`]).
+pub(crate) fn load_segments(
+    p: &Protocol,
+    path: &std::path::Path,
+    bars: &Bars,
+) -> Result<(Loaded, Option<Vec<Segment>>)> {
     let spinner = bars.spinner(format!("loading {}", path.display()));
-    let loaded = dataset::load(
-        p.dataset,
-        path,
-        &p.load_options,
-        &p.segmentation,
-        p.max_units,
-    )
-    .with_context(|| format!("cannot load {}", path.display()))?;
+    let cannot = || format!("cannot load {}", path.display());
+    p.segmentation.validate()?;
+    let t =
+        dataset::load_tracks(p.dataset, path, &p.load_options, p.max_units).with_context(cannot)?;
+    let (segments, counts) = p.segmentation.apply(&t.tracks).with_context(cannot)?;
+    let pool = match &p.train_segmentation {
+        Some(ts) => Some(ts.apply(&t.tracks).with_context(cannot)?),
+        None => None,
+    };
+    let loaded = Loaded {
+        segments,
+        report: t.report,
+        tracks: t.tracks.len(),
+        units_read: t.units_read,
+        units_total: t.units_total,
+        counts,
+    };
     spinner.finish_and_clear();
     eprintln!("{}: {}", path.display(), loaded.summary());
+    if let (Some(ts), Some((pool, c))) = (&p.train_segmentation, &pool) {
+        eprintln!(
+            "{}: cut for training where fixes are more than {} s apart: {} segments of {} \
+             kept ({} points), {} shorter than the minimum",
+            path.display(),
+            ts.max_gap.map_or("never".to_string(), |g| g.to_string()),
+            pool.len(),
+            c.segments_all,
+            c.points,
+            c.too_short
+        );
+    }
     if loaded.segments.len() < 2 {
         bail!(
             "{}: need at least 2 segments of {} points, found {}",
@@ -65,5 +92,5 @@ pub(crate) fn load_segments(p: &Protocol, path: &std::path::Path, bars: &Bars) -
             loaded.segments.len()
         );
     }
-    Ok(loaded)
+    Ok((loaded, pool.map(|(s, _)| s)))
 }

@@ -10,7 +10,7 @@ mod output;
 mod progress;
 
 use anyhow::{Context, Result, bail};
-use args::{LimitArgs, SegmentArgs, SplitArg};
+use args::{LimitArgs, SegmentArgs, SplitArg, TrainCutArgs};
 use clap::{Parser, Subcommand};
 use custom::{custom_options, custom_protocol, load_segments};
 use output::{Format, table, write_atomic, write_forecast};
@@ -128,6 +128,8 @@ enum Command {
         #[command(flatten)]
         segment: SegmentArgs,
         #[command(flatten)]
+        train_cut: TrainCutArgs,
+        #[command(flatten)]
         limits: LimitArgs,
         /// Read at most this many units (GeoLife users, T-Drive taxis, files).
         #[arg(long)]
@@ -190,6 +192,8 @@ enum Command {
         horizon: usize,
         #[command(flatten)]
         segment: SegmentArgs,
+        #[command(flatten)]
+        train_cut: TrainCutArgs,
         #[command(flatten)]
         limits: LimitArgs,
         /// Read at most this many units (GeoLife users, T-Drive taxis, files).
@@ -372,6 +376,7 @@ fn run(cli: Cli) -> Result<()> {
             stride,
             max_origins,
             segment,
+            train_cut,
             limits,
             max_units,
             limit,
@@ -452,6 +457,7 @@ fn run(cli: Cli) -> Result<()> {
                 }
             };
             p.load_options = limits.apply(p.load_options);
+            p.train_segmentation = train_cut.of(&p.segmentation);
             // bad settings and misspelt methods fail before the (possibly long) loading
             p.validate()?;
             for m in &p.methods {
@@ -470,10 +476,13 @@ fn run(cli: Cli) -> Result<()> {
                     );
                 }
             }
-            let loaded = load_segments(&p, &path, &bars)?;
+            let (loaded, pool) = load_segments(&p, &path, &bars)?;
             if let Some(k) = folds {
                 if saved.is_some() {
                     bail!("--folds fits every fold anew: it cannot use --params");
+                }
+                if pool.is_some() {
+                    bail!("--folds cuts every fold from --max-gap: it cannot use --train-max-gap");
                 }
                 if !matches!(p.split, Split::ByGroup { .. }) {
                     bail!("--folds cross-validates by user: use it with --split by-user");
@@ -508,6 +517,11 @@ fn run(cli: Cli) -> Result<()> {
                         );
                     }
                     run
+                }
+                None if pool.is_some() => {
+                    let split = protocol::split_with_pool(&p, &loaded.segments, pool.as_deref())?;
+                    let n = loaded.segments.len();
+                    protocol::run_split(&p, n, split, &bars, &protocol::build_and_fit)?
                 }
                 None => protocol::run(&p, &loaded.segments, &bars)?,
             };
@@ -602,6 +616,7 @@ fn run(cli: Cli) -> Result<()> {
             history,
             horizon,
             segment,
+            train_cut,
             limits,
             max_units,
             split,
@@ -633,12 +648,13 @@ fn run(cli: Cli) -> Result<()> {
                 ds, &names, &opts, &segment, history, horizon, max_units, split,
             );
             p.load_options = limits.apply(p.load_options);
+            p.train_segmentation = train_cut.of(&p.segmentation);
             // bad settings, misspelt methods and methods that cannot be saved fail before
             // the loading
             p.validate()?;
             params::check_exportable(&p.methods)?;
-            let loaded = load_segments(&p, &path, &bars)?;
-            let file = params::fit(&p, &path, &loaded.segments, &bars)?;
+            let (loaded, pool) = load_segments(&p, &path, &bars)?;
+            let file = params::fit(&p, &path, &loaded.segments, pool.as_deref(), &bars)?;
             file.save(&output)?;
             let on = &file.fitted_on;
             for m in &file.methods {
