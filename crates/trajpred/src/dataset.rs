@@ -409,15 +409,34 @@ pub fn load(
     segmentation: &Segmentation,
     max_units: Option<usize>,
 ) -> Result<Loaded> {
+    load_cut_twice(dataset, path, opts, segmentation, None, max_units).map(|(l, _)| l)
+}
+
+/// [`load`], the tracks also cut by `other` when given (a protocol's
+/// [training segmentation](crate::protocol::Protocol::train_segmentation)): read once,
+/// segmented twice.
+pub fn load_cut_twice(
+    dataset: Dataset,
+    path: &Path,
+    opts: &LoadOptions,
+    segmentation: &Segmentation,
+    other: Option<&Segmentation>,
+    max_units: Option<usize>,
+) -> Result<(Loaded, Option<(Vec<Segment>, SegmentCounts)>)> {
     segmentation.validate()?;
+    if let Some(o) = other {
+        o.validate()?;
+    }
     let t = load_tracks(dataset, path, opts, max_units)?;
     let (segments, counts) = segmentation.apply(&t.tracks)?;
-    Ok(Loaded {
+    let second = other.map(|o| o.apply(&t.tracks)).transpose()?;
+    let loaded = Loaded {
         segments,
         report: t.report,
         tracks: t.tracks.len(),
         units_read: t.units_read,
         units_total: t.units_total,
         counts,
-    })
+    };
+    Ok((loaded, second))
 }

@@ -53,23 +53,15 @@ pub(crate) fn load_segments(
     bars: &Bars,
 ) -> Result<(Loaded, Option<Vec<Segment>>)> {
     let spinner = bars.spinner(format!("loading {}", path.display()));
-    let cannot = || format!("cannot load {}", path.display());
-    p.segmentation.validate()?;
-    let t =
-        dataset::load_tracks(p.dataset, path, &p.load_options, p.max_units).with_context(cannot)?;
-    let (segments, counts) = p.segmentation.apply(&t.tracks).with_context(cannot)?;
-    let pool = match &p.train_segmentation {
-        Some(ts) => Some(ts.apply(&t.tracks).with_context(cannot)?),
-        None => None,
-    };
-    let loaded = Loaded {
-        segments,
-        report: t.report,
-        tracks: t.tracks.len(),
-        units_read: t.units_read,
-        units_total: t.units_total,
-        counts,
-    };
+    let (loaded, pool) = dataset::load_cut_twice(
+        p.dataset,
+        path,
+        &p.load_options,
+        &p.segmentation,
+        p.train_segmentation.as_ref(),
+        p.max_units,
+    )
+    .with_context(|| format!("cannot load {}", path.display()))?;
     spinner.finish_and_clear();
     eprintln!("{}: {}", path.display(), loaded.summary());
     if let (Some(ts), Some((pool, c))) = (&p.train_segmentation, &pool) {
