@@ -412,6 +412,9 @@ pub fn load(
     load_cut_twice(dataset, path, opts, segmentation, None, max_units).map(|(l, _)| l)
 }
 
+/// Segments cut from tracks, with the counts of the cut ([`Segmentation::apply`]).
+pub type Cut = (Vec<Segment>, SegmentCounts);
+
 /// [`load`], the tracks also cut by `other` when given (a protocol's
 /// [training segmentation](crate::protocol::Protocol::train_segmentation)): read once,
 /// segmented twice.
@@ -422,7 +425,7 @@ pub fn load_cut_twice(
     segmentation: &Segmentation,
     other: Option<&Segmentation>,
     max_units: Option<usize>,
-) -> Result<(Loaded, Option<(Vec<Segment>, SegmentCounts)>)> {
+) -> Result<(Loaded, Option<Cut>)> {
     segmentation.validate()?;
     if let Some(o) = other {
         o.validate()?;
