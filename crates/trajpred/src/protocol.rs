@@ -311,6 +311,10 @@ impl Protocol {
                 .resample
                 .map_or(String::new(), |dt| format!(", resampled every {dt} s")),
         );
+        if let Some(t) = &self.train_segmentation {
+            let gap = t.max_gap.map_or("none".to_string(), |g| g.to_string());
+            let _ = writeln!(s, "  training tracks cut at: max gap {gap} s");
+        }
         let (fraction, seed) = (self.split.train_fraction(), self.split.seed());
         let _ = writeln!(
             s,
