@@ -72,7 +72,10 @@ fn the_training_part_comes_from_the_training_users_other_cut_and_the_test_part_i
     let plain = protocol(BY_USER, false);
     let cut = protocol(BY_USER, true);
     cut.validate().expect("valid");
-    assert!(cut.describe().contains("training tracks cut at: max gap 120 s"));
+    assert!(
+        cut.describe()
+            .contains("training tracks cut at: max gap 120 s")
+    );
     assert!(!plain.describe().contains("training tracks cut"));
     let (plain_train, plain_test, _) = protocol::split_counted(&plain, &halves).expect("split");
     let (train, test, _) =
